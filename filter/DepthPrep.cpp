@@ -1,0 +1,99 @@
+// Nearest-neighbour resize and push-pull hole filling of depth maps (Gortler et al. 1996).
+#include "filter/DepthPrep.hpp"
+
+#include <algorithm>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+namespace defocus {
+
+namespace {
+
+// Fills pixels with weight < 1 in `value` from a half-resolution pyramid level, recursively.
+// `value` holds weighted averages where weight > 0; weight is in [0, 1].
+void pushPull(cv::Mat& value, cv::Mat& weight)
+{
+    if (value.rows <= 1 && value.cols <= 1)
+        return;
+    const cv::Size half((value.cols + 1) / 2, (value.rows + 1) / 2);
+    // Push: area-average value*weight and weight; their ratio is the weighted mean of each block.
+    cv::Mat weighted = value.mul(weight);
+    cv::Mat coarseWeighted, coarseWeight;
+    cv::resize(weighted, coarseWeighted, half, 0, 0, cv::INTER_AREA);
+    cv::resize(weight, coarseWeight, half, 0, 0, cv::INTER_AREA);
+    cv::Mat coarseValue;
+    cv::divide(coarseWeighted, cv::max(coarseWeight, 1e-12), coarseValue);
+    // A coarse pixel is fully trusted once its block held one full sample's worth of weight.
+    coarseWeight = cv::min(coarseWeight * 4.0, 1.0);
+    if (cv::countNonZero(coarseWeight < 1.0f) > 0)
+        pushPull(coarseValue, coarseWeight);
+    // Pull: blend the upsampled coarse level into the holes.
+    cv::Mat up;
+    cv::resize(coarseValue, up, value.size(), 0, 0, cv::INTER_LINEAR);
+    cv::Mat inverse = 1.0 - weight;
+    value = weighted + up.mul(inverse);
+    weight = cv::Mat::ones(value.size(), CV_32F);
+}
+
+} // namespace
+
+PreparedDepth prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM)
+{
+    PreparedDepth out;
+    if (depth.empty()) {
+        out.metres = cv::Mat(size, CV_32F, cv::Scalar(fallbackM));
+        out.invalidFraction = 1.0;
+        return out;
+    }
+    CV_Assert(depth.type() == CV_32FC1);
+    cv::Mat resized;
+    if (depth.size() == size)
+        resized = depth.clone();
+    else
+        cv::resize(depth, resized, size, 0, 0, cv::INTER_NEAREST);
+
+    cv::Mat weight(size, CV_32F);
+    std::size_t invalid = 0;
+    for (int y = 0; y < resized.rows; ++y) {
+        auto* z = resized.ptr<float>(y);
+        auto* w = weight.ptr<float>(y);
+        for (int x = 0; x < resized.cols; ++x) {
+            const bool valid = isValidDepth(z[x]);
+            w[x] = valid ? 1.0f : 0.0f;
+            if (!valid) {
+                z[x] = 0.0f;
+                ++invalid;
+            }
+        }
+    }
+    out.invalidFraction = static_cast<double>(invalid) / static_cast<double>(size.area());
+    if (invalid == static_cast<std::size_t>(size.area()))
+        resized.setTo(fallbackM);
+    else if (invalid > 0)
+        pushPull(resized, weight);
+    out.metres = resized;
+    return out;
+}
+
+float centreDepth(const cv::Mat& depth, double windowFraction, float fallbackM)
+{
+    if (depth.empty())
+        return fallbackM;
+    const int w = std::max(1, static_cast<int>(depth.cols * windowFraction));
+    const int h = std::max(1, static_cast<int>(depth.rows * windowFraction));
+    const cv::Rect window((depth.cols - w) / 2, (depth.rows - h) / 2, w, h);
+    std::vector<float> values;
+    values.reserve(static_cast<std::size_t>(w * h));
+    for (int y = window.y; y < window.y + window.height; ++y)
+        for (int x = window.x; x < window.x + window.width; ++x)
+            if (const float z = depth.at<float>(y, x); isValidDepth(z))
+                values.push_back(z);
+    if (values.empty())
+        return fallbackM;
+    auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+}
+
+} // namespace defocus

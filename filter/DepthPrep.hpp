@@ -1,0 +1,33 @@
+// Depth as the CoC pass needs it: colour-sized, in metres, with every hole filled.
+#pragma once
+
+#include <limits>
+
+#include <opencv2/core.hpp>
+
+namespace defocus {
+
+/// Depths at or below this (metres) are no measurement, like 0, negative, NaN and +-Inf.
+inline constexpr float kMinValidDepthM = 1e-4f;
+
+inline bool isValidDepth(float z)
+{
+    return z > kMinValidDepthM && z < std::numeric_limits<float>::infinity();
+}
+
+struct PreparedDepth {
+    cv::Mat metres;                ///< CV_32FC1, colour-sized, every pixel valid
+    double invalidFraction = 0.0;  ///< share of pixels that had no measurement, [0, 1]
+};
+
+/// Resizes `depth` (CV_32FC1 metres, any size) to `size` by nearest neighbour, so no depth is
+/// invented between a foreground and a background, then fills holes by push-pull: a pyramid of
+/// averages of the valid neighbours, coarse levels filling what finer ones cannot. A frame with
+/// no valid depth at all (or no depth) becomes `fallbackM` everywhere.
+PreparedDepth prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM);
+
+/// Robust depth of the centre of the frame: the median of valid depths in the central
+/// `windowFraction` of each axis; `fallbackM` when that window has no valid depth.
+float centreDepth(const cv::Mat& depth, double windowFraction, float fallbackM);
+
+} // namespace defocus

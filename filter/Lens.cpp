@@ -1,0 +1,69 @@
+// Thin-lens and focal-range CoC coefficients.
+#include "filter/Lens.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace defocus {
+
+CocCoefficients cocCoefficients(const LensSettings& lens, int imageWidthPx)
+{
+    CocCoefficients k;
+    k.maxCocPx = static_cast<float>(lens.maxCocPx);
+    k.focusM = static_cast<float>(std::min(lens.focusM, 1e30));
+    const double pixelsPerMetreOnSensor = imageWidthPx / (lens.sensorWidthMm * 1e-3);
+
+    if (lens.model == CocModel::ThinLens) {
+        // With f the focal length, N the f-number, A = f / N the aperture diameter, S1 the focus
+        // distance and S2 = z the depth (all in metres), the signed CoC on the sensor is
+        //   c = A (z - S1) / z * f / (S1 - f)
+        //     = A f / (S1 - f)  -  A f S1 / (S1 - f) * (1 / z)
+        // so c = K0 * (1/z) + K1 with K1 = A f / (S1 - f) and K0 = -K1 * S1, times pixels per
+        // metre of sensor. As S1 -> inf, K1 -> 0 and K0 -> -A f: everything is in front of focus.
+        const double f = lens.focalLengthMm * 1e-3;
+        const double aperture = f / lens.fNumber;
+        double k0 = 0.0, k1 = 0.0;
+        if (std::isinf(lens.focusM)) {
+            k0 = -aperture * f;
+        } else {
+            k1 = aperture * f / (lens.focusM - f);
+            k0 = -k1 * lens.focusM;
+        }
+        k.nearScale = k.farScale = static_cast<float>(k0 * pixelsPerMetreOnSensor);
+        k.nearOffset = k.farOffset = static_cast<float>(k1 * pixelsPerMetreOnSensor);
+        k.inverseDepth = true;
+    } else {
+        // Linear ramps in z: c = -max (S1 - z) / (S1 - near) in front, max (z - S1) / (far - S1)
+        // behind, i.e. c = s * z + o with s = max / (S1 - near), o = -s * S1 (and likewise far).
+        k.inverseDepth = false;
+        const double nearScale = lens.maxCocPx / (lens.focusM - lens.nearLimitM);
+        k.nearScale = static_cast<float>(nearScale);
+        k.nearOffset = static_cast<float>(-nearScale * lens.focusM);
+        if (!std::isinf(lens.farLimitM)) {
+            const double farScale = lens.maxCocPx / (lens.farLimitM - lens.focusM);
+            k.farScale = static_cast<float>(farScale);
+            k.farOffset = static_cast<float>(-farScale * lens.focusM);
+        }
+    }
+    return k;
+}
+
+float cocPixels(const CocCoefficients& k, float depthM)
+{
+    const float x = k.inverseDepth ? 1.0f / depthM : depthM;
+    const float c = depthM < k.focusM ? k.nearScale * x + k.nearOffset : k.farScale * x + k.farOffset;
+    return std::clamp(c, -k.maxCocPx, k.maxCocPx);
+}
+
+double thinLensCocPixels(const LensSettings& lens, int imageWidthPx, double depthM)
+{
+    const double f = lens.focalLengthMm * 1e-3;
+    const double A = f / lens.fNumber;
+    const double S1 = lens.focusM;
+    const double S2 = depthM;
+    const double c = A * std::abs(S2 - S1) / S2 * f / (S1 - f);
+    const double signedC = S2 < S1 ? -c : c;
+    return signedC * imageWidthPx / (lens.sensorWidthMm * 1e-3);
+}
+
+} // namespace defocus

@@ -1,0 +1,72 @@
+// The McIntosh hexagonal-bokeh chain: upload -> CoC -> blur 0 deg -> blur +-120 deg -> min().
+// Owns every intermediate target and reallocates them only when size or format changes.
+// Needs a current GL 4.5 context (gl::EglContext) for its whole life.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "filter/Frame.hpp"
+#include "filter/Settings.hpp"
+
+namespace defocus {
+
+/// How read() returns pixels.
+enum class Encoding {
+    Srgb8,    ///< CV_8UC3 BGR, sRGB-encoded (encoded on the GPU)
+    Linear32F ///< CV_32FC3 BGR, scene-linear, unclipped
+};
+
+struct PassTime {
+    std::string name;
+    double ms = 0.0;
+};
+
+/// Where the time of the last frame went. Wall times are CPU-side; `gpu` comes from timer
+/// queries (empty when the driver has none).
+struct FrameTimings {
+    double depthPrepMs = 0.0; ///< resize + hole filling on the CPU
+    double uploadMs = 0.0;    ///< colour + depth to textures
+    double renderMs = 0.0;    ///< submitting the passes
+    double readbackMs = 0.0;  ///< output pass + glReadPixels (waits for the GPU)
+    double totalMs = 0.0;     ///< process() + read(), wall clock
+    std::vector<PassTime> gpu;
+};
+
+class Pipeline {
+public:
+    /// Compiles every pass; throws gl::ShaderError on a driver that rejects a shader.
+    /// `timers`: use GL timer queries when the driver offers them.
+    explicit Pipeline(bool timers = true);
+    ~Pipeline();
+    Pipeline(const Pipeline&) = delete;
+    Pipeline& operator=(const Pipeline&) = delete;
+
+    /// Runs the passes for `frame`. `lens` and `quality` must have passed validate().
+    void process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality);
+    /// Renders `view` of the last processed frame and reads it back. Depth and CoC views carry a
+    /// legend along their bottom edge.
+    cv::Mat read(View view, Encoding encoding);
+    /// process() + read() in one call.
+    cv::Mat run(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
+                View view = View::Composite, Encoding encoding = Encoding::Srgb8);
+
+    /// Reads an intermediate target as CV_32FC4 RGBA (rgb linear, a = signed CoC in pixels),
+    /// for tests and analysis: one of Input (the CoC pass), Horizontal, DiagonalA, DiagonalB.
+    cv::Mat readTarget(View view) const;
+
+    /// The last frame's filled depth (CV_32FC1 metres) and the share of it that was holes.
+    const cv::Mat& filledDepth() const;
+    double invalidDepthFraction() const;
+    /// Timings of the last process() + read().
+    const FrameTimings& timings() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace defocus

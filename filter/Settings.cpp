@@ -1,0 +1,83 @@
+// The one place where settings are checked against their documented ranges.
+#include "filter/Settings.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace defocus {
+
+namespace {
+
+constexpr std::string_view kViewNames[] = {"input", "horizontal", "diagonal-a", "diagonal-b",
+                                           "composite", "depth", "coc"};
+
+template <typename T>
+void checkRange(std::vector<SettingIssue>& issues, std::string_view parameter, T& value, T low, T high,
+                bool clamp)
+{
+    if (std::isfinite(static_cast<double>(value)) && value >= low && value <= high)
+        return;
+    issues.push_back({std::string(parameter), fmt::format("{} {} is outside [{}, {}]", parameter, value, low, high)});
+    if (clamp)
+        value = std::isnan(static_cast<double>(value)) ? low : std::clamp(value, low, high);
+}
+
+} // namespace
+
+std::string_view viewName(View view)
+{
+    return kViewNames[static_cast<int>(view)];
+}
+
+bool parseView(std::string_view name, View& view)
+{
+    for (const View candidate : kAllViews) {
+        if (viewName(candidate) == name) {
+            view = candidate;
+            return true;
+        }
+    }
+    return false;
+}
+
+std::vector<SettingIssue> validate(LensSettings& lens, bool clamp)
+{
+    std::vector<SettingIssue> issues;
+    checkRange(issues, "--focal-length", lens.focalLengthMm, limits::kFocalLengthMm[0], limits::kFocalLengthMm[1], clamp);
+    checkRange(issues, "--f-number", lens.fNumber, limits::kFNumber[0], limits::kFNumber[1], clamp);
+    checkRange(issues, "--sensor-width", lens.sensorWidthMm, limits::kSensorWidthMm[0], limits::kSensorWidthMm[1], clamp);
+    checkRange(issues, "--max-coc", lens.maxCocPx, limits::kMaxCocPx[0], limits::kMaxCocPx[1], clamp);
+
+    // The thin lens only images points beyond its focal length: focus must be farther than f.
+    const double focalLengthM = lens.focalLengthMm * 1e-3;
+    if (std::isnan(lens.focusM) || lens.focusM <= focalLengthM) {
+        issues.push_back({"--focus", fmt::format("--focus {} m must be farther than the focal length ({} m)",
+                                                 lens.focusM, focalLengthM)});
+        if (clamp)
+            lens.focusM = std::isnan(lens.focusM) ? 2.0 : focalLengthM * 1.01;
+    }
+    if (lens.model == CocModel::FocalRange) {
+        if (!(lens.nearLimitM >= 0.0 && lens.nearLimitM < lens.focusM)) {
+            issues.push_back({"--near", fmt::format("--near {} m must be in [0, focus {} m)", lens.nearLimitM, lens.focusM)});
+            if (clamp)
+                lens.nearLimitM = std::isnan(lens.nearLimitM) ? 0.0 : std::clamp(lens.nearLimitM, 0.0, lens.focusM * 0.99);
+        }
+        if (!(lens.farLimitM > lens.focusM)) {
+            issues.push_back({"--far", fmt::format("--far {} m must be farther than focus {} m", lens.farLimitM, lens.focusM)});
+            if (clamp)
+                lens.farLimitM = lens.focusM * 1.01;
+        }
+    }
+    return issues;
+}
+
+std::vector<SettingIssue> validate(QualitySettings& quality, bool clamp)
+{
+    std::vector<SettingIssue> issues;
+    checkRange(issues, "--samples", quality.samples, limits::kSamples[0], limits::kSamples[1], clamp);
+    return issues;
+}
+
+} // namespace defocus

@@ -1,0 +1,88 @@
+// The filter's settings, one struct per concern, each field with its unit, default and range.
+// All validation happens in validate() below: the CLI turns its messages into errors, an
+// interactive session clamps with a warning.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace defocus {
+
+/// How depth becomes a circle of confusion.
+enum class CocModel {
+    ThinLens,   ///< physical thin lens from focal length, f-number, focus distance, sensor width
+    FocalRange  ///< blur rising linearly from the focus distance to max-coc at a near and a far limit
+};
+
+struct LensSettings {
+    CocModel model = CocModel::ThinLens;
+    /// Focal length, millimetres, [1, 1200].
+    double focalLengthMm = 50.0;
+    /// f-number N (aperture diameter = focal length / N), [0.7, 64].
+    double fNumber = 2.0;
+    /// Distance to the plane in focus, metres, (focal length, +inf]; +inf focuses at infinity.
+    double focusM = 2.0;
+    /// Sensor width, millimetres, [1, 100]; the image width is fitted to it.
+    double sensorWidthMm = 36.0;
+    /// Largest CoC diameter, pixels, [0, 512]; larger blur is clamped to it.
+    double maxCocPx = 32.0;
+    /// FocalRange model only: distance where blur reaches max-coc in front of the focus, metres,
+    /// [0, focusM).
+    double nearLimitM = 1.0;
+    /// FocalRange model only: distance where blur reaches max-coc behind the focus, metres,
+    /// (focusM, +inf].
+    double farLimitM = 6.0;
+};
+
+/// Render-target precision of the intermediate passes.
+enum class TargetFormat {
+    Rgba16F, ///< half float: enough for colour and a CoC in pixels, half the bandwidth
+    Rgba32F  ///< full float
+};
+
+struct QualitySettings {
+    /// Taps per directional blur pass, [2, 64].
+    int samples = 16;
+    TargetFormat targetFormat = TargetFormat::Rgba16F;
+};
+
+/// What the pipeline writes out. The first five are the McIntosh lab's modes 1-5.
+enum class View {
+    Input,      ///< 1: the colour the blur starts from (after the CoC pass)
+    Horizontal, ///< 2: after the 0 degree blur
+    DiagonalA,  ///< 3: horizontal result blurred at +120 degrees
+    DiagonalB,  ///< 4: horizontal result blurred at -120 degrees
+    Composite,  ///< 5: min(A, B), the depth-of-field result
+    Depth,      ///< filled depth, colour-mapped, with a legend
+    Coc         ///< signed CoC (near < 0 < far), colour-mapped, with a legend
+};
+
+inline constexpr View kAllViews[] = {View::Input,     View::Horizontal, View::DiagonalA, View::DiagonalB,
+                                     View::Composite, View::Depth,      View::Coc};
+
+std::string_view viewName(View view);
+/// Parses a view name as printed by viewName(); returns false when unknown.
+bool parseView(std::string_view name, View& view);
+
+/// One problem with a setting: which parameter, its value, the allowed range.
+struct SettingIssue {
+    std::string parameter; ///< CLI name, e.g. "--f-number"
+    std::string message;   ///< e.g. "--f-number 0.5 is outside [0.7, 64]"
+};
+
+/// Checks every field against its documented range. With `clamp`, out-of-range values are
+/// replaced by the nearest allowed one (the issues are still returned, as warnings).
+std::vector<SettingIssue> validate(LensSettings& lens, bool clamp = false);
+std::vector<SettingIssue> validate(QualitySettings& quality, bool clamp = false);
+
+namespace limits {
+inline constexpr double kFocalLengthMm[] = {1.0, 1200.0};
+inline constexpr double kFNumber[] = {0.7, 64.0};
+inline constexpr double kSensorWidthMm[] = {1.0, 100.0};
+inline constexpr double kMaxCocPx[] = {0.0, 512.0};
+inline constexpr int kSamples[] = {2, 64};
+} // namespace limits
+
+} // namespace defocus

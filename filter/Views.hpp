@@ -1,0 +1,25 @@
+// CPU-side finishing of views: the legend of the colour-mapped views and the labelled contact
+// sheet of all views of a frame.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace defocus {
+
+enum class LegendKind {
+    DepthMetres,    ///< log ramp, labels in metres
+    SignedCocPixels ///< diverging ramp, labels in pixels (near negative)
+};
+
+/// Draws a colour bar with its end and middle labels along the bottom edge of `image`
+/// (CV_8UC3 sRGB or CV_32FC3 linear). Images narrower than 160 px are left as they are.
+void drawLegend(cv::Mat& image, LegendKind kind, float low, float high);
+
+/// Lays out labelled tiles (CV_8UC3) in a grid of `columns`, each with its label above it.
+cv::Mat contactSheet(const std::vector<std::pair<std::string, cv::Mat>>& tiles, int columns = 4);
+
+} // namespace defocus

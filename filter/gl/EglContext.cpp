@@ -1,0 +1,199 @@
+// EGL device platform first, Mesa surfaceless next; OpenGL 4.5 core; no surface at all.
+#include "filter/gl/EglContext.hpp"
+
+#include <utility>
+#include <vector>
+
+#include <epoxy/egl.h>
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+namespace defocus::gl {
+
+struct EglContext::State {
+    EGLDisplay display = EGL_NO_DISPLAY;
+    EGLContext context = EGL_NO_CONTEXT;
+
+    ~State()
+    {
+        if (display == EGL_NO_DISPLAY)
+            return;
+        eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        if (context != EGL_NO_CONTEXT)
+            eglDestroyContext(display, context);
+        eglTerminate(display);
+    }
+};
+
+namespace {
+
+std::string eglErrorName(EGLint error)
+{
+    switch (error) {
+    case EGL_SUCCESS: return "EGL_SUCCESS";
+    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
+    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
+    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
+    default: return fmt::format("EGL error 0x{:x}", error);
+    }
+}
+
+bool hasExtension(const char* list, std::string_view name)
+{
+    if (list == nullptr)
+        return false;
+    std::string_view all(list);
+    for (std::size_t pos = 0; (pos = all.find(name, pos)) != std::string_view::npos; pos += name.size()) {
+        const bool startOk = pos == 0 || all[pos - 1] == ' ';
+        const bool endOk = pos + name.size() == all.size() || all[pos + name.size()] == ' ';
+        if (startOk && endOk)
+            return true;
+    }
+    return false;
+}
+
+void GLAPIENTRY logGlMessage(GLenum, GLenum type, GLuint, GLenum severity, GLsizei, const GLchar* message,
+                             const void*)
+{
+    if (severity == GL_DEBUG_SEVERITY_NOTIFICATION)
+        return;
+    if (type == GL_DEBUG_TYPE_ERROR)
+        spdlog::error("GL: {}", message);
+    else
+        spdlog::debug("GL: {}", message);
+}
+
+// Initialises `display`, binds desktop GL and creates a 4.5 core context on it.
+// Returns an empty string on success, else why it failed.
+std::string tryDisplay(EGLDisplay display, EglContext::State& state, bool debug)
+{
+    if (display == EGL_NO_DISPLAY)
+        return "no display";
+    EGLint major = 0, minor = 0;
+    if (eglInitialize(display, &major, &minor) != EGL_TRUE)
+        return "eglInitialize failed: " + eglErrorName(eglGetError());
+    state.display = display;
+    if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE)
+        return "no desktop OpenGL API: " + eglErrorName(eglGetError());
+
+    const char* extensions = eglQueryString(display, EGL_EXTENSIONS);
+    EGLConfig config = nullptr;
+    if (!hasExtension(extensions, "EGL_KHR_no_config_context")) {
+        const EGLint configAttributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+        EGLint count = 0;
+        if (eglChooseConfig(display, configAttributes, &config, 1, &count) != EGL_TRUE || count < 1)
+            return "no OpenGL-renderable EGL config";
+    }
+    const EGLint contextAttributes[] = {
+        EGL_CONTEXT_MAJOR_VERSION, 4,
+        EGL_CONTEXT_MINOR_VERSION, 5,
+        EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+        EGL_CONTEXT_OPENGL_DEBUG, debug ? EGL_TRUE : EGL_FALSE,
+        EGL_NONE};
+    state.context = eglCreateContext(display, config, EGL_NO_CONTEXT, contextAttributes);
+    if (state.context == EGL_NO_CONTEXT)
+        return "no OpenGL 4.5 core context: " + eglErrorName(eglGetError());
+    if (eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, state.context) != EGL_TRUE)
+        return "cannot make the context current without a surface: " + eglErrorName(eglGetError());
+    return {};
+}
+
+std::string glString(GLenum name)
+{
+    const auto* text = reinterpret_cast<const char*>(glGetString(name));
+    return text ? text : "";
+}
+
+} // namespace
+
+EglContext EglContext::create(bool debug)
+{
+    const char* clientExtensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    std::vector<std::string> tried;
+    auto state = std::make_unique<State>();
+    std::string platform;
+
+    // 1. Device platform: enumerate EGL devices and take the first one that gives a context.
+    if (hasExtension(clientExtensions, "EGL_EXT_device_enumeration") &&
+        hasExtension(clientExtensions, "EGL_EXT_platform_device")) {
+        EGLint count = 0;
+        eglQueryDevicesEXT(0, nullptr, &count);
+        std::vector<EGLDeviceEXT> devices(static_cast<std::size_t>(count));
+        if (count > 0)
+            eglQueryDevicesEXT(count, devices.data(), &count);
+        if (count == 0)
+            tried.emplace_back("EGL device platform: no devices");
+        for (EGLint i = 0; i < count && platform.empty(); ++i) {
+            const char* deviceExtensions = eglQueryDeviceStringEXT(devices[i], EGL_EXTENSIONS);
+            EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
+            const std::string why = tryDisplay(display, *state, debug);
+            if (why.empty()) {
+                platform = hasExtension(deviceExtensions, "EGL_MESA_device_software") ? "device (software)"
+                                                                                       : "device";
+            } else {
+                tried.push_back(fmt::format("EGL device {}: {}", i, why));
+                state = std::make_unique<State>();
+            }
+        }
+    } else {
+        tried.emplace_back("EGL device platform: extension not offered");
+    }
+
+    // 2. Mesa's surfaceless platform.
+    if (platform.empty()) {
+        if (hasExtension(clientExtensions, "EGL_MESA_platform_surfaceless")) {
+            EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+            const std::string why = tryDisplay(display, *state, debug);
+            if (why.empty())
+                platform = "surfaceless";
+            else
+                tried.push_back("Mesa surfaceless platform: " + why);
+        } else {
+            tried.emplace_back("Mesa surfaceless platform: extension not offered");
+        }
+    }
+
+    if (platform.empty())
+        throw ContextError(fmt::format("defocus::gl::EglContext::create(): no headless OpenGL 4.5 context ({})",
+                                       fmt::join(tried, "; ")));
+
+    EglContext context(std::move(state));
+    ContextInfo& info = context.info_;
+    info.platform = platform;
+    info.eglVendor = eglQueryString(context.state_->display, EGL_VENDOR);
+    info.eglVersion = eglQueryString(context.state_->display, EGL_VERSION);
+    info.glVendor = glString(GL_VENDOR);
+    info.glRenderer = glString(GL_RENDERER);
+    info.glVersion = glString(GL_VERSION);
+    GLint timerBits = 0;
+    glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &timerBits);
+    info.timerQueries = timerBits > 0;
+    if (epoxy_gl_version() < 45)
+        throw ContextError(fmt::format("defocus::gl::EglContext::create(): {} offers OpenGL {}, 4.5 is needed",
+                                       info.glRenderer, info.glVersion));
+    if (debug) {
+        glEnable(GL_DEBUG_OUTPUT);
+        glDebugMessageCallback(logGlMessage, nullptr);
+    }
+    spdlog::debug("EGL {} platform: {} / {}", info.platform, info.glRenderer, info.glVersion);
+    return context;
+}
+
+EglContext::EglContext(std::unique_ptr<State> state) : state_(std::move(state)) {}
+EglContext::EglContext(EglContext&&) noexcept = default;
+EglContext& EglContext::operator=(EglContext&&) noexcept = default;
+EglContext::~EglContext() = default;
+
+void EglContext::makeCurrent() const
+{
+    eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, state_->context);
+}
+
+} // namespace defocus::gl

@@ -1,0 +1,96 @@
+// RAII GL object wrappers: creation with DSA (GL 4.5), deletion, debug labels.
+#include "filter/gl/Objects.hpp"
+
+#include <cassert>
+
+namespace defocus::gl {
+
+void deleteTexture(GLuint id) { glDeleteTextures(1, &id); }
+void deleteFramebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
+void deleteBuffer(GLuint id) { glDeleteBuffers(1, &id); }
+void deleteVertexArray(GLuint id) { glDeleteVertexArrays(1, &id); }
+void deleteSampler(GLuint id) { glDeleteSamplers(1, &id); }
+void deleteQuery(GLuint id) { glDeleteQueries(1, &id); }
+void deleteProgram(GLuint id) { glDeleteProgram(id); }
+
+void label(GLenum identifier, GLuint id, std::string_view name)
+{
+    if (epoxy_has_gl_extension("GL_KHR_debug"))
+        glObjectLabel(identifier, id, static_cast<GLsizei>(name.size()), name.data());
+}
+
+Texture::Texture(GLenum internalFormat, int width, int height, std::string_view name)
+    : format_(internalFormat), width_(width), height_(height)
+{
+    assert(width > 0 && height > 0);
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &id);
+    handle_ = Handle<deleteTexture>(id);
+    glTextureStorage2D(id, 1, internalFormat, width, height);
+    label(GL_TEXTURE, id, name);
+}
+
+void Texture::upload(GLenum format, GLenum type, const void* data)
+{
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTextureSubImage2D(id(), 0, 0, 0, width_, height_, format, type, data);
+}
+
+Framebuffer::Framebuffer(const Texture& texture, std::string_view name)
+    : width_(texture.width()), height_(texture.height())
+{
+    GLuint id = 0;
+    glCreateFramebuffers(1, &id);
+    handle_ = Handle<deleteFramebuffer>(id);
+    glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, texture.id(), 0);
+    label(GL_FRAMEBUFFER, id, name);
+}
+
+void Framebuffer::bindForDraw() const
+{
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, id());
+    glViewport(0, 0, width_, height_);
+}
+
+Sampler::Sampler(GLenum filter, std::string_view name)
+{
+    GLuint id = 0;
+    glCreateSamplers(1, &id);
+    handle_ = Handle<deleteSampler>(id);
+    glSamplerParameteri(id, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(filter));
+    glSamplerParameteri(id, GL_TEXTURE_MAG_FILTER, static_cast<GLint>(filter));
+    glSamplerParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    label(GL_SAMPLER, id, name);
+}
+
+UniformBuffer::UniformBuffer(GLsizeiptr size, std::string_view name) : size_(size)
+{
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    handle_ = Handle<deleteBuffer>(id);
+    glNamedBufferStorage(id, size, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    label(GL_BUFFER, id, name);
+}
+
+void UniformBuffer::update(const void* data, GLsizeiptr size)
+{
+    assert(size <= size_);
+    glNamedBufferSubData(id(), 0, size, data);
+}
+
+void UniformBuffer::bind(GLuint binding) const
+{
+    glBindBufferBase(GL_UNIFORM_BUFFER, binding, id());
+}
+
+VertexArray VertexArray::create()
+{
+    GLuint id = 0;
+    glCreateVertexArrays(1, &id);
+    VertexArray vao;
+    vao.handle_ = Handle<deleteVertexArray>(id);
+    return vao;
+}
+
+} // namespace defocus::gl

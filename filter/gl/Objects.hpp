@@ -1,0 +1,131 @@
+// Move-only RAII owners for GL objects. A default-constructed object is explicitly empty (id 0);
+// moving leaves the source empty. Each object can carry a debug label (GL_KHR_debug).
+#pragma once
+
+#include <string_view>
+#include <utility>
+
+#include <epoxy/gl.h>
+
+namespace defocus::gl {
+
+/// Shared ownership logic: `Deleter` frees one id.
+template <void (*Deleter)(GLuint)>
+class Handle {
+public:
+    Handle() = default;
+    explicit Handle(GLuint id) : id_(id) {}
+    Handle(Handle&& other) noexcept : id_(std::exchange(other.id_, 0)) {}
+    Handle& operator=(Handle&& other) noexcept
+    {
+        if (this != &other) {
+            reset();
+            id_ = std::exchange(other.id_, 0);
+        }
+        return *this;
+    }
+    Handle(const Handle&) = delete;
+    Handle& operator=(const Handle&) = delete;
+    ~Handle() { reset(); }
+
+    GLuint id() const { return id_; }
+    explicit operator bool() const { return id_ != 0; }
+    void reset()
+    {
+        if (id_ != 0)
+            Deleter(std::exchange(id_, 0));
+    }
+
+private:
+    GLuint id_ = 0;
+};
+
+void deleteTexture(GLuint id);
+void deleteFramebuffer(GLuint id);
+void deleteBuffer(GLuint id);
+void deleteVertexArray(GLuint id);
+void deleteSampler(GLuint id);
+void deleteQuery(GLuint id);
+void deleteProgram(GLuint id);
+
+/// Labels an object for GL debuggers and driver messages (no-op without GL_KHR_debug).
+void label(GLenum identifier, GLuint id, std::string_view name);
+
+/// An immutable-storage 2D texture (glTextureStorage2D) of one level.
+class Texture {
+public:
+    Texture() = default;
+    Texture(GLenum internalFormat, int width, int height, std::string_view name);
+
+    GLuint id() const { return handle_.id(); }
+    explicit operator bool() const { return bool(handle_); }
+    GLenum format() const { return format_; }
+    int width() const { return width_; }
+    int height() const { return height_; }
+    /// Replaces the whole image; `data` rows are tightly packed.
+    void upload(GLenum format, GLenum type, const void* data);
+
+private:
+    Handle<deleteTexture> handle_;
+    GLenum format_ = 0;
+    int width_ = 0;
+    int height_ = 0;
+};
+
+/// A framebuffer with one colour attachment: the render target of one pass.
+class Framebuffer {
+public:
+    Framebuffer() = default;
+    /// Attaches `texture` (not owned; must outlive this framebuffer).
+    Framebuffer(const Texture& texture, std::string_view name);
+
+    GLuint id() const { return handle_.id(); }
+    explicit operator bool() const { return bool(handle_); }
+    int width() const { return width_; }
+    int height() const { return height_; }
+    /// Binds for drawing and sets the viewport to the whole attachment.
+    void bindForDraw() const;
+
+private:
+    Handle<deleteFramebuffer> handle_;
+    int width_ = 0;
+    int height_ = 0;
+};
+
+/// A sampler object: filtering and edge clamping, separate from the texture.
+class Sampler {
+public:
+    Sampler() = default;
+    Sampler(GLenum filter, std::string_view name);
+    GLuint id() const { return handle_.id(); }
+
+private:
+    Handle<deleteSampler> handle_;
+};
+
+/// A uniform buffer sized for one C++ struct that mirrors a std140 GLSL block.
+class UniformBuffer {
+public:
+    UniformBuffer() = default;
+    UniformBuffer(GLsizeiptr size, std::string_view name);
+    void update(const void* data, GLsizeiptr size);
+    void bind(GLuint binding) const;
+    GLuint id() const { return handle_.id(); }
+
+private:
+    Handle<deleteBuffer> handle_;
+    GLsizeiptr size_ = 0;
+};
+
+/// The empty vertex array that a full-screen triangle drawn from gl_VertexID needs in core GL.
+class VertexArray {
+public:
+    VertexArray() = default;
+    static VertexArray create();
+    GLuint id() const { return handle_.id(); }
+
+private:
+    Handle<deleteVertexArray> handle_;
+};
+
+} // namespace defocus::gl

@@ -1,0 +1,33 @@
+// Pass 1: linear colour + signed CoC (pixels) in alpha, into a float target. Shader: coc.frag.
+#pragma once
+
+#include "filter/Lens.hpp"
+#include "filter/gl/Objects.hpp"
+#include "filter/gl/Program.hpp"
+
+namespace defocus {
+
+class CocPass {
+public:
+    static constexpr const char* kName = "coc";
+    CocPass();
+    /// `color`: sRGB8 or float RGB; `depth`: R32F metres with no holes; `halfTarget` keeps HDR
+    /// colour below the half-float maximum.
+    void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
+             const gl::Framebuffer& target);
+
+private:
+    /// Mirrors the std140 block CocParams in coc.frag.
+    struct Uniforms {
+        float coefficients[4];
+        float focusM;
+        float maxCocPx;
+        int inverseDepth;
+        float largestColor;
+    };
+    gl::Program program_;
+    gl::UniformBuffer uniforms_;
+    gl::Sampler nearest_;
+};
+
+} // namespace defocus

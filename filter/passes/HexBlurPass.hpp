@@ -1,0 +1,45 @@
+// One directional blur of the McIntosh hexagonal bokeh (pass 2, 3 or 4). Shader: hex_blur.frag.
+#pragma once
+
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+#include "filter/gl/Objects.hpp"
+#include "filter/gl/Program.hpp"
+
+namespace defocus {
+
+class HexBlurPass {
+public:
+    static constexpr int kMaxSamples = 64;
+    /// The paper's bleeding fix constants, in its unit (CoC as a fraction of image height).
+    static constexpr float kBleedingBias = 0.02f;
+    static constexpr float kBleedingMult = 30.0f;
+
+    HexBlurPass();
+    /// Blurs `source` (rgb + signed CoC) along `angleDegrees` (counter-clockwise on screen, 0 =
+    /// horizontal) with `samples` taps; `depth` is the filled depth in metres.
+    void run(const gl::Texture& source, const gl::Texture& depth, float angleDegrees, int samples,
+             const gl::Framebuffer& target);
+
+    /// Texture-space tap offsets per pixel of CoC diameter: `samples` points evenly spaced from
+    /// -d/2 to +d/2 along the angle, divided by the image size so that pixels stay square.
+    static std::vector<glm::vec2> offsets(float angleDegrees, int samples, int width, int height);
+
+private:
+    /// Mirrors the std140 block HexBlurParams in hex_blur.frag.
+    struct Uniforms {
+        float offsets[kMaxSamples][4];
+        int sampleCount;
+        float bleedingBias;
+        float bleedingMult;
+        float cocToPaperUnits;
+    };
+    gl::Program program_;
+    gl::UniformBuffer uniforms_;
+    gl::Sampler linear_;
+    gl::Sampler nearest_;
+};
+
+} // namespace defocus

@@ -1,0 +1,55 @@
+#version 450 core
+// One directional blur of McIntosh, Riecke & DiPaola 2012, "Efficiently Simulating the Bokeh of
+// Polygonal Apertures in a Post-Process Depth of Field Shader". Run at 0 deg on the CoC pass,
+// then at +120 and -120 deg on that result; min() of the two is a hexagon:
+//
+//   pass 0 deg      +120 deg of it     -120 deg of it     min(A, B)
+//    ______           ______            ______             ____
+//                    /     /            \     \           /    \
+//                   /_____/              \_____\          \____/
+//
+// Each pass averages `sampleCount` taps on a segment as long as the centre's CoC diameter.
+// The paper's bleeding fix: a tap nearer than the centre and sharper than it (by more than
+// bleedingBias) is weighted by its own blurriness * bleedingMult, so sharp foreground does not
+// smear onto a blurry background; blurriness is in the paper's unit, a fraction of image height.
+layout(location = 0) in vec2 vUv;
+layout(location = 0) out vec4 outColor;
+
+layout(binding = 0) uniform sampler2D uSource; // rgb + signed CoC (px) in alpha, linear filtering
+layout(binding = 1) uniform sampler2D uDepth;  // metres, nearest filtering
+
+layout(std140, binding = 0) uniform HexBlurParams {
+    vec4 offsets[MAX_SAMPLES]; // xy: texture-space offset per pixel of CoC diameter
+    int sampleCount;
+    float bleedingBias;
+    float bleedingMult;
+    float cocToPaperUnits;     // 1 / image height in pixels
+};
+
+void main()
+{
+    const vec4 center = textureLod(uSource, vUv, 0.0);
+    const float diameter = abs(center.a);
+    if (diameter < 0.5) { // a CoC below half a pixel is in focus: keep the pixel as it is
+        outColor = center;
+        return;
+    }
+    const float centerDepth = textureLod(uDepth, vUv, 0.0).r;
+    const float centerBlur = diameter * cocToPaperUnits;
+
+    vec4 sum = vec4(0.0);
+    float totalWeight = 0.0;
+    for (int i = 0; i < sampleCount; ++i) {
+        const vec2 coords = vUv + offsets[i].xy * diameter;
+        const vec4 tap = textureLod(uSource, coords, 0.0);
+        const float tapDepth = textureLod(uDepth, coords, 0.0).r;
+        const float tapBlur = abs(tap.a) * cocToPaperUnits;
+        float weight = tapDepth < centerDepth ? tapBlur * bleedingMult : 1.0;
+        weight = centerBlur > tapBlur + bleedingBias ? weight : 1.0;
+        weight = clamp(weight, 0.0, 1.0);
+        sum += tap * weight;
+        totalWeight += weight;
+    }
+    // Every tap rejected (sharp foreground all around): keep the centre rather than divide by 0.
+    outColor = totalWeight > 1e-6 ? sum / totalWeight : center;
+}

@@ -1,0 +1,53 @@
+// The one contract every input implements: a pull-based stream of RGB-D frames.
+//   defocus data/tum_fr1_rpy -o out.mp4            (TUM layout: rgb.txt + depth.txt)
+//   defocus rgb_dir/ --depth depth_dir/ -o out/    (pair of folders, matched by sorted name)
+//   defocus photo.png --depth depth.png -o out.png (one colour file + one depth file)
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "filter/Frame.hpp"
+
+namespace defocus {
+
+/// Thrown for anything wrong with the input on disk; the message names the file (and line or
+/// frame) and what is wrong with it.
+class SourceError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+class FrameSource {
+public:
+    virtual ~FrameSource() = default;
+    /// The next frame, or nullopt at the end of the stream. Throws SourceError when a frame
+    /// cannot be read; the stream may not be resumed after that.
+    virtual std::optional<Frame> next() = 0;
+    /// Number of frames, when known in advance (recorded clips).
+    virtual std::optional<std::size_t> frameCount() const { return std::nullopt; }
+    /// Nominal frame rate in Hz, used by video sinks; 0 when unknown.
+    virtual double frameRate() const { return 0.0; }
+    /// One line for logs: kind and location, e.g. "TUM RGB-D sequence data/tum (10 pairs)".
+    virtual std::string describe() const = 0;
+};
+
+struct SourceOptions {
+    /// A TUM folder, a folder of colour images, or a single colour image file.
+    std::filesystem::path input;
+    /// Depth for `input`: a folder (paired by sorted file name) or a single file. Not needed
+    /// for the TUM layout, which names its own depth files.
+    std::optional<std::filesystem::path> depth;
+    /// Units per metre of 16-bit depth images. Unset: 5000 for the TUM layout, 1000 otherwise.
+    std::optional<double> depthScale;
+};
+
+/// Opens the source that `options.input` names; throws SourceError with a clear message when
+/// it does not exist or cannot be recognised.
+std::unique_ptr<FrameSource> openSource(const SourceOptions& options);
+
+} // namespace defocus

@@ -1,0 +1,30 @@
+// Helpers shared by the tests.
+#include "tests/TestSupport.hpp"
+
+#include <cstdlib>
+
+namespace defocus::test {
+
+std::filesystem::path dataDir()
+{
+    return DEFOCUS_DATA_DIR;
+}
+
+std::filesystem::path scratchDir(const std::string& name)
+{
+    const auto dir = std::filesystem::path(DEFOCUS_BINARY_DIR) / "test-scratch" / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+bool allFinite(const cv::Mat& m)
+{
+    if (m.depth() != CV_32F && m.depth() != CV_64F && m.depth() != CV_16F)
+        return true;
+    cv::Mat f;
+    m.convertTo(f, CV_32F);
+    return cv::checkRange(f);
+}
+
+} // namespace defocus::test

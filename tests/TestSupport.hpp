@@ -1,0 +1,18 @@
+// Helpers shared by the tests: where the bundled data lives, scratch folders, image statistics.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace defocus::test {
+
+/// The repository's data/ folder (bundled fixtures).
+std::filesystem::path dataDir();
+/// A fresh, empty folder under the build tree for one test's files.
+std::filesystem::path scratchDir(const std::string& name);
+/// True when every element of `m` (any depth, any channels) is finite.
+bool allFinite(const cv::Mat& m);
+
+} // namespace defocus::test
