@@ -1,0 +1,274 @@
+// defocus: gives recorded RGB-D footage the depth of field of a real lens, with hexagonal bokeh.
+//   defocus data/tum_fr1_rpy -o out/tum.mp4 --focus 1.2 --f-number 1.4
+//   defocus photo.png --depth depth.png --depth-scale 1000 -o out.png --view coc
+//   defocus --info
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
+
+#include "filter/DepthPrep.hpp"
+#include "filter/Pipeline.hpp"
+#include "filter/Settings.hpp"
+#include "filter/Views.hpp"
+#include "filter/gl/EglContext.hpp"
+#include "filter/gl/Program.hpp"
+#include "samples/Progress.hpp"
+#include "sinks/FrameSink.hpp"
+#include "sources/FrameSource.hpp"
+
+namespace {
+
+using namespace defocus;
+
+std::atomic<bool> gStop{false};
+
+extern "C" void onSignal(int)
+{
+    gStop = true;
+}
+
+/// Exit codes: 0 done, 1 runtime failure (input, output, GL), 2 bad command line, 130 stopped.
+enum Exit { kOk = 0, kFailure = 1, kUsage = 2, kInterrupted = 130 };
+
+struct Options {
+    std::string input;
+    std::string output;
+    std::string depth;
+    std::optional<double> depthScale;
+    std::string focus = "auto";
+    LensSettings lens;
+    QualitySettings quality;
+    std::string model = "thin-lens";
+    std::string precision = "16f";
+    std::string view = "composite";
+    std::string contactSheet;
+    std::size_t contactFrame = 0;
+    std::optional<std::size_t> frames;
+    std::optional<double> fps;
+    bool info = false;
+    bool quiet = false;
+    bool verbose = false;
+};
+
+int printInfo()
+{
+    const auto context = gl::EglContext::create();
+    const auto& info = context.info();
+    fmt::print("EGL platform: {}\nEGL vendor:   {}\nEGL version:  {}\nGL vendor:    {}\nGL renderer:  {}\n"
+               "GL version:   {}\nGPU timers:   {}\n",
+               info.platform, info.eglVendor, info.eglVersion, info.glVendor, info.glRenderer, info.glVersion,
+               info.timerQueries ? "yes" : "no");
+    return kOk;
+}
+
+std::string summarise(std::size_t in, std::size_t out, const std::map<std::string, double>& passMs,
+                      double totalMs, double uploadMs, double readbackMs, std::size_t timed)
+{
+    const double n = static_cast<double>(std::max<std::size_t>(timed, 1));
+    std::string passes;
+    for (const char* name : {"coc", "horizontal", "diagonal-a", "diagonal-b", "composite", "view"})
+        if (const auto found = passMs.find(name); found != passMs.end())
+            passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", name, found->second / n);
+    return fmt::format("defocus: {} frames in, {} frames out, {:.1f} ms/frame (GPU per pass: {}; upload {:.1f}, "
+                       "readback {:.1f} ms)",
+                       in, out, totalMs / n, passes.empty() ? "n/a" : passes, uploadMs / n, readbackMs / n);
+}
+
+int run(const Options& options)
+{
+    SourceOptions sourceOptions{options.input, std::nullopt, options.depthScale};
+    if (!options.depth.empty())
+        sourceOptions.depth = options.depth;
+    auto source = openSource(sourceOptions);
+
+    View view = View::Composite;
+    parseView(options.view, view); // validated by CLI11's check
+
+    auto context = gl::EglContext::create();
+    Pipeline pipeline;
+    if (!options.quiet)
+        spdlog::info("{} -> {} on {}", source->describe(), options.output, context.info().glRenderer);
+
+    SinkOptions sinkOptions{options.output, options.fps.value_or(source->frameRate() > 0 ? source->frameRate() : 30.0),
+                            false};
+    auto sink = openSink(sinkOptions);
+    const Encoding encoding = sink->encoding() == SinkEncoding::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
+
+    std::optional<std::size_t> total = source->frameCount();
+    if (options.frames)
+        total = total ? std::min(*total, *options.frames) : *options.frames;
+    Progress progress(total, !options.quiet);
+
+    LensSettings lens = options.lens;
+    std::map<std::string, double> passMs;
+    double totalMs = 0, uploadMs = 0, readbackMs = 0;
+    std::size_t framesIn = 0, timed = 0;
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+
+    int exitCode = kOk;
+    try {
+        while (!gStop && (!options.frames || framesIn < *options.frames)) {
+            std::optional<Frame> frame = source->next();
+            if (!frame)
+                break;
+            ++framesIn;
+            if (framesIn == 1 && options.focus == "auto") {
+                lens.focusM = centreDepth(frame->depth, 0.1, 2.0f);
+                if (!options.quiet)
+                    spdlog::info("focus: auto -> {:.2f} m (median depth of the centre of {})", lens.focusM, frame->name);
+                if (const auto issues = validate(lens); !issues.empty())
+                    throw std::runtime_error(fmt::format("automatic focus: {}", issues.front().message));
+            }
+            cv::Mat image = pipeline.run(*frame, lens, options.quality, view, encoding);
+            if (!options.contactSheet.empty() && frame->index == options.contactFrame) {
+                std::vector<std::pair<std::string, cv::Mat>> tiles;
+                int number = 1;
+                for (const View v : kAllViews)
+                    tiles.emplace_back(fmt::format("{} {}", number++, viewName(v)), pipeline.read(v, Encoding::Srgb8));
+                if (!cv::imwrite(options.contactSheet, contactSheet(tiles)))
+                    throw SinkError(fmt::format("cannot write contact sheet '{}'", options.contactSheet));
+                pipeline.run(*frame, lens, options.quality, view, encoding); // keep timings of a plain frame
+            }
+            sink->write(image);
+
+            const FrameTimings& t = pipeline.timings();
+            if (framesIn > 1 || total == std::optional<std::size_t>(1)) { // frame 1 pays for shader warm-up
+                for (const auto& pass : t.gpu)
+                    passMs[pass.name] += pass.ms;
+                totalMs += t.totalMs;
+                uploadMs += t.uploadMs;
+                readbackMs += t.readbackMs;
+                ++timed;
+            }
+            progress.update(framesIn);
+        }
+    } catch (const std::exception& error) {
+        progress.finish();
+        spdlog::error("frame {}: {}", framesIn, error.what());
+        exitCode = kFailure;
+    }
+    sink->finish();
+    progress.finish();
+    if (gStop) {
+        spdlog::warn("stopped by signal after {} frames; {} is finalised", framesIn, options.output);
+        exitCode = kInterrupted;
+    }
+    if (exitCode == kOk && framesIn == 0) {
+        spdlog::error("{} gave no frames", options.input);
+        return kFailure;
+    }
+    std::puts(summarise(framesIn, sink->framesWritten(), passMs, totalMs, uploadMs, readbackMs, timed).c_str());
+    if (!options.quiet)
+        spdlog::info("wrote {}", sink->describe());
+    return exitCode;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    Options o;
+    CLI::App app{"defocus: depth of field with hexagonal bokeh for RGB-D images and clips (McIntosh et al. 2012).\n"
+                 "INPUT is a TUM RGB-D folder (rgb.txt + depth.txt), a folder of colour images (with --depth "
+                 "FOLDER), or one colour image (with --depth FILE)."};
+    app.set_version_flag("--version", "defocus 0.1.0");
+    app.add_option("input", o.input, "Colour input: TUM folder, image folder or image file");
+    app.add_option("-o,--output", o.output,
+                   "Output: DIR/ (numbered PNGs), FILE.mp4|.mkv|.avi (video), FILE.png (one frame), FILE.exr "
+                   "(one frame, linear float)");
+    app.add_option("--depth", o.depth, "Depth for INPUT: a folder (paired by sorted name) or one file");
+    app.add_option("--depth-scale", o.depthScale,
+                   "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--focus", o.focus,
+                   "Distance in focus, metres; 'inf' for infinity; 'auto' = median depth of the centre of the "
+                   "first frame")
+        ->capture_default_str();
+    app.add_option("--f-number", o.lens.fNumber, "Aperture as an f-number N (smaller = more blur), 0.7..64")
+        ->capture_default_str();
+    app.add_option("--focal-length", o.lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
+    app.add_option("--sensor-width", o.lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
+        ->capture_default_str();
+    app.add_option("--max-coc", o.lens.maxCocPx, "Largest blur diameter, pixels, 0..512")->capture_default_str();
+    app.add_option("--coc-model", o.model,
+                   "thin-lens (physical) or focal-range (blur rises linearly from --focus to max at --near/--far)")
+        ->check(CLI::IsMember({"thin-lens", "focal-range"}))
+        ->capture_default_str();
+    app.add_option("--near", o.lens.nearLimitM, "focal-range model: metres where near blur reaches --max-coc")
+        ->capture_default_str();
+    app.add_option("--far", o.lens.farLimitM, "focal-range model: metres where far blur reaches --max-coc")
+        ->capture_default_str();
+    app.add_option("--samples", o.quality.samples, "Taps per directional blur pass, 2..64")->capture_default_str();
+    app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f")
+        ->check(CLI::IsMember({"16f", "32f"}))
+        ->capture_default_str();
+    std::vector<std::string> views;
+    for (const View v : kAllViews)
+        views.emplace_back(viewName(v));
+    app.add_option("--view", o.view, "What to write: " + fmt::format("{}", fmt::join(views, ", ")))
+        ->check(CLI::IsMember(views))
+        ->capture_default_str();
+    app.add_option("--contact-sheet", o.contactSheet, "Also write every view of one frame, labelled, to this PNG");
+    app.add_option("--contact-frame", o.contactFrame, "Frame index for --contact-sheet")->capture_default_str();
+    app.add_option("--frames", o.frames, "Stop after this many frames")->check(CLI::PositiveNumber);
+    app.add_option("--fps", o.fps, "Frame rate of a video output, Hz [default: the input's]")->check(CLI::PositiveNumber);
+    app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
+    app.add_flag("-q,--quiet", o.quiet, "Only the summary line and errors");
+    app.add_flag("-v,--verbose", o.verbose, "Debug logging");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    spdlog::set_pattern("%^defocus: %l:%$ %v");
+    spdlog::set_level(o.verbose ? spdlog::level::debug : o.quiet ? spdlog::level::warn : spdlog::level::info);
+
+    try {
+        if (o.info)
+            return printInfo();
+        if (o.input.empty() || o.output.empty()) {
+            spdlog::error("INPUT and -o OUTPUT are required (see --help)");
+            return kUsage;
+        }
+        o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
+        o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
+        if (o.focus == "inf" || o.focus == "infinity") {
+            o.lens.focusM = std::numeric_limits<double>::infinity();
+        } else if (o.focus != "auto") {
+            try {
+                std::size_t used = 0;
+                o.lens.focusM = std::stod(o.focus, &used);
+                if (used != o.focus.size())
+                    throw std::invalid_argument(o.focus);
+            } catch (const std::logic_error&) {
+                spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);
+                return kUsage;
+            }
+        }
+        LensSettings lensToCheck = o.lens;
+        if (o.focus == "auto")
+            lensToCheck.focusM = std::max(lensToCheck.focusM, lensToCheck.focalLengthMm * 2e-3);
+        auto issues = validate(lensToCheck);
+        const auto qualityIssues = validate(o.quality);
+        issues.insert(issues.end(), qualityIssues.begin(), qualityIssues.end());
+        for (const auto& issue : issues)
+            spdlog::error("{}", issue.message);
+        if (!issues.empty())
+            return kUsage;
+        return run(o);
+    } catch (const std::exception& error) {
+        spdlog::error("{}", error.what());
+        return kFailure;
+    }
+}

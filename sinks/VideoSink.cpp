@@ -1,0 +1,178 @@
+// Video sink: chooses a FourCC per container with fallbacks, writes to a partial file and renames
+// it into place when finished.
+#include "sinks/VideoSink.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <opencv2/videoio/registry.hpp>
+#include <spdlog/spdlog.h>
+
+namespace defocus {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Size of the probe video written (and deleted) by the constructor.
+const cv::Size probeSize{64, 48};
+
+std::string lowerExtension(const fs::path& file)
+{
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
+}
+
+// In order of preference. mp4v (MPEG-4 Part 2) and MJPG are built into FFmpeg itself; X264 needs
+// libx264, so .mkv falls back to mp4v and then lossless FFV1.
+std::vector<std::string> codecsFor(const std::string& ext)
+{
+    if (ext == ".mp4")
+        return {"mp4v"};
+    if (ext == ".avi")
+        return {"MJPG"};
+    if (ext == ".mkv")
+        return {"X264", "mp4v", "FFV1"};
+    return {};
+}
+
+std::string joined(const std::vector<std::string>& items)
+{
+    std::string out;
+    for (const std::string& item : items)
+        out += (out.empty() ? "" : ", ") + item;
+    return out;
+}
+
+} // namespace
+
+VideoSink::VideoSink(fs::path file, double fps) : file_(std::move(file)), fps_(fps)
+{
+    const std::string ext = lowerExtension(file_);
+    const std::vector<std::string> codecs = codecsFor(ext);
+    if (codecs.empty())
+        throw SinkError(fmt::format("cannot write video '{}': unsupported container '{}' (use "
+                                    ".mp4, .mkv or .avi)",
+                                    file_.string(), ext));
+    if (!(fps_ > 0.0) || !std::isfinite(fps_))
+        throw SinkError(fmt::format("cannot write video '{}': the frame rate must be positive, "
+                                    "got {}",
+                                    file_.string(), fps_));
+    partial_ = file_.parent_path() / (file_.stem().string() + ".partial" + file_.extension().string());
+
+    std::error_code ec;
+    const fs::path dir = file_.parent_path().empty() ? fs::path(".") : file_.parent_path();
+    fs::create_directories(dir, ec);
+    const fs::path probe = dir / fmt::format(".defocus-write-test-{}", ::getpid());
+    const bool writable = std::ofstream(probe).good();
+    fs::remove(probe, ec);
+    if (!writable)
+        throw SinkError(fmt::format("cannot write video '{}': folder '{}' is not writable",
+                                    file_.string(), dir.string()));
+
+    for (const std::string& candidate : codecs) {
+        cv::VideoWriter writer;
+        const bool opened = openWriter(writer, candidate, probeSize);
+        writer.release();
+        fs::remove(partial_, ec);
+        if (opened) {
+            codec_ = candidate;
+            break;
+        }
+        spdlog::debug("video '{}': codec {} does not open here", file_.string(), candidate);
+    }
+    if (codec_.empty())
+        throw SinkError(fmt::format("cannot write video '{}': no encoder opens for codec {} "
+                                    "(OpenCV's FFmpeg lacks it)",
+                                    file_.string(), joined(codecs)));
+    if (codec_ != codecs.front())
+        spdlog::info("video '{}': codec {} unavailable, using {}", file_.string(), codecs.front(),
+                     codec_);
+}
+
+VideoSink::~VideoSink()
+{
+    try {
+        finish();
+    } catch (const std::exception& e) {
+        spdlog::error("{}", e.what());
+    }
+}
+
+bool VideoSink::openWriter(cv::VideoWriter& writer, const std::string& fourcc, cv::Size size) const
+{
+    // FFmpeg directly: with CAP_ANY a failed open falls through to GStreamer, which only adds
+    // noise to the log.
+    const int api = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY;
+    try {
+        return writer.open(partial_.string(), api,
+                           cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]),
+                           fps_, size, true);
+    } catch (const cv::Exception& e) {
+        spdlog::debug("video '{}': {} failed to open: {}", file_.string(), fourcc, e.err);
+        return false;
+    }
+}
+
+void VideoSink::write(const cv::Mat& image)
+{
+    if (finished_)
+        throw SinkError(fmt::format("cannot write video '{}': already finished", file_.string()));
+    if (image.empty() || image.type() != CV_8UC3)
+        throw SinkError(fmt::format("cannot write video '{}': expected a non-empty CV_8UC3 frame, "
+                                    "got {} {}x{}",
+                                    file_.string(), cv::typeToString(image.type()), image.cols,
+                                    image.rows));
+    if (!writer_.isOpened()) {
+        if (!openWriter(writer_, codec_, image.size()))
+            throw SinkError(fmt::format("cannot write video '{}': codec {} does not open at "
+                                        "{}x{}",
+                                        file_.string(), codec_, image.cols, image.rows));
+        size_ = image.size();
+        if (size_.width % 2 != 0 || size_.height % 2 != 0)
+            spdlog::warn("video '{}': frames are {}x{}; codecs with 4:2:0 chroma store {}x{}",
+                         file_.string(), size_.width, size_.height, size_.width & ~1,
+                         size_.height & ~1);
+    } else if (image.size() != size_) {
+        throw SinkError(fmt::format("cannot write video '{}': frame {} is {}x{} but the video is "
+                                    "{}x{}",
+                                    file_.string(), written_, image.cols, image.rows, size_.width,
+                                    size_.height));
+    }
+    writer_.write(image);
+    ++written_;
+}
+
+void VideoSink::finish()
+{
+    if (finished_)
+        return;
+    finished_ = true;
+    writer_.release();
+    std::error_code ec;
+    if (written_ == 0) {
+        fs::remove(partial_, ec);
+        spdlog::warn("video '{}': no frames written, so no file created", file_.string());
+        return;
+    }
+    fs::rename(partial_, file_, ec);
+    if (ec)
+        throw SinkError(fmt::format("cannot write video '{}': renaming '{}' failed: {}",
+                                    file_.string(), partial_.string(), ec.message()));
+}
+
+std::string VideoSink::describe() const
+{
+    return fmt::format("video '{}' ({}, {:g} fps)", file_.string(), codec_, fps_);
+}
+
+} // namespace defocus

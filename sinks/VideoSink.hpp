@@ -1,0 +1,49 @@
+// Video output through cv::VideoWriter (FFmpeg): .mp4 as MPEG-4 Part 2 (mp4v), .avi as Motion
+// JPEG, .mkv as H.264 when an encoder exists.   defocus data/tum_fr1_rpy -o out.mp4
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+
+#include <opencv2/videoio.hpp>
+
+#include "sinks/FrameSink.hpp"
+
+namespace defocus {
+
+class VideoSink final : public FrameSink {
+public:
+    /// Picks the codec for the container and proves at once that it opens (a tiny probe file,
+    /// deleted again), so that a missing encoder or an unwritable folder fails before any frame
+    /// is processed. Frames go to NAME.partial.EXT, renamed to `file` by finish().
+    /// Throws SinkError naming the file and the codecs tried.
+    VideoSink(std::filesystem::path file, double fps);
+    ~VideoSink() override;
+    VideoSink(const VideoSink&) = delete;
+    VideoSink& operator=(const VideoSink&) = delete;
+
+    SinkEncoding encoding() const override { return SinkEncoding::Srgb8; }
+    /// The first frame fixes the size; a frame of another size throws SinkError.
+    void write(const cv::Mat& image) override;
+    void finish() override;
+    std::size_t framesWritten() const override { return written_; }
+    std::string describe() const override;
+
+    /// FourCC in use, e.g. "mp4v".
+    const std::string& codec() const { return codec_; }
+
+private:
+    bool openWriter(cv::VideoWriter& writer, const std::string& fourcc, cv::Size size) const;
+
+    std::filesystem::path file_;
+    std::filesystem::path partial_;
+    double fps_;
+    std::string codec_;
+    cv::VideoWriter writer_;
+    cv::Size size_;
+    std::size_t written_ = 0;
+    bool finished_ = false;
+};
+
+} // namespace defocus

@@ -1,0 +1,154 @@
+// Folder pair source: lists the images of a colour folder (and a depth folder), sorts both by
+// name and reads them pair by pair.
+#include "sources/FolderPairSource.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <string_view>
+#include <system_error>
+#include <utility>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "sources/ImageIO.hpp"
+
+namespace defocus {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool isImageFile(const fs::path& file)
+{
+    static constexpr std::array<std::string_view, 7> extensions = {
+        ".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".bmp"};
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return std::find(extensions.begin(), extensions.end(), ext) != extensions.end();
+}
+
+bool isDigit(char c)
+{
+    return std::isdigit(static_cast<unsigned char>(c)) != 0;
+}
+
+// Natural order: runs of digits compare by value, so "frame2" sorts before "frame10".
+bool naturalLess(std::string_view a, std::string_view b)
+{
+    std::size_t i = 0;
+    std::size_t j = 0;
+    while (i < a.size() && j < b.size()) {
+        if (isDigit(a[i]) && isDigit(b[j])) {
+            std::size_t iEnd = i;
+            std::size_t jEnd = j;
+            while (iEnd < a.size() && isDigit(a[iEnd]))
+                ++iEnd;
+            while (jEnd < b.size() && isDigit(b[jEnd]))
+                ++jEnd;
+            std::string_view x = a.substr(i, iEnd - i);
+            std::string_view y = b.substr(j, jEnd - j);
+            x.remove_prefix(std::min(x.find_first_not_of('0'), x.size()));
+            y.remove_prefix(std::min(y.find_first_not_of('0'), y.size()));
+            if (x.size() != y.size())
+                return x.size() < y.size();
+            if (x != y)
+                return x < y;
+            i = iEnd;
+            j = jEnd;
+        } else {
+            if (a[i] != b[j])
+                return a[i] < b[j];
+            ++i;
+            ++j;
+        }
+    }
+    if (a.size() - i != b.size() - j)
+        return a.size() - i < b.size() - j;
+    return a < b; // equal by value ("f01" and "f1"): any fixed order
+}
+
+std::vector<fs::path> listImages(const fs::path& folder)
+{
+    std::vector<fs::path> files;
+    try {
+        for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+            const std::string name = entry.path().filename().string();
+            if (name.empty() || name.front() == '.' || !entry.is_regular_file() ||
+                !isImageFile(entry.path()))
+                continue;
+            files.push_back(entry.path());
+        }
+    } catch (const fs::filesystem_error& e) {
+        throw SourceError(fmt::format("cannot list folder '{}': {}", folder.string(),
+                                      e.code().message()));
+    }
+    std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
+        return naturalLess(a.filename().string(), b.filename().string());
+    });
+    return files;
+}
+
+} // namespace
+
+FolderPairSource::FolderPairSource(fs::path colorFolder, std::optional<fs::path> depth,
+                                   double unitsPerMetre)
+    : colorFolder_(std::move(colorFolder)), depth_(std::move(depth)),
+      unitsPerMetre_(unitsPerMetre)
+{
+    colorFiles_ = listImages(colorFolder_);
+    if (colorFiles_.empty())
+        throw SourceError(fmt::format(
+            "folder '{}' holds no images (png, jpg, jpeg, exr, tif, tiff or bmp)",
+            colorFolder_.string()));
+    std::error_code ec;
+    if (!depth_) {
+        spdlog::warn("image folder '{}': no depth given; its {} frames pass through in focus",
+                     colorFolder_.string(), colorFiles_.size());
+    } else if (fs::is_directory(*depth_, ec)) {
+        depthFiles_ = listImages(*depth_);
+        if (depthFiles_.size() != colorFiles_.size())
+            throw SourceError(fmt::format(
+                "colour folder '{}' holds {} images but depth folder '{}' holds {}; they are "
+                "paired one to one by sorted name",
+                colorFolder_.string(), colorFiles_.size(), depth_->string(), depthFiles_.size()));
+    } else {
+        sharedDepth_ = readDepth(*depth_, unitsPerMetre_);
+    }
+}
+
+std::optional<Frame> FolderPairSource::next()
+{
+    if (next_ >= colorFiles_.size())
+        return std::nullopt;
+    Frame frame;
+    frame.color = readColor(colorFiles_[next_]);
+    if (!depthFiles_.empty())
+        frame.depth = readDepth(depthFiles_[next_], unitsPerMetre_);
+    else if (!sharedDepth_.empty())
+        frame.depth = sharedDepth_.clone(); // each frame owns its pixels
+    frame.index = next_;
+    frame.name = colorFiles_[next_].filename().string();
+    ++next_;
+    return frame;
+}
+
+std::optional<std::size_t> FolderPairSource::frameCount() const
+{
+    return colorFiles_.size();
+}
+
+std::string FolderPairSource::describe() const
+{
+    if (!depth_)
+        return fmt::format("image folder '{}' ({} frames, no depth)", colorFolder_.string(),
+                           colorFiles_.size());
+    if (!depthFiles_.empty())
+        return fmt::format("folder pair '{}' + '{}' ({} frames)", colorFolder_.string(),
+                           depth_->string(), colorFiles_.size());
+    return fmt::format("image folder '{}' ({} frames) + one depth image '{}'",
+                       colorFolder_.string(), colorFiles_.size(), depth_->string());
+}
+
+} // namespace defocus

@@ -1,0 +1,82 @@
+// openSource: recognises what the input path names (TUM folder, image folder, image or video
+// file) and opens the matching source.
+#include "sources/FrameSource.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <string_view>
+#include <system_error>
+
+#include <fmt/format.h>
+
+#include "sources/FolderPairSource.hpp"
+#include "sources/SingleImageSource.hpp"
+#include "sources/TumSource.hpp"
+#include "sources/VideoFileSource.hpp"
+
+namespace defocus {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Units per metre of 16-bit depth when the options do not say: TUM publishes depth in
+/// 1/5000 m; most other tools (Kinect SDK, RealSense, Blender's 16-bit export) use millimetres.
+constexpr double tumUnitsPerMetre = 5000.0;
+constexpr double defaultUnitsPerMetre = 1000.0;
+
+bool isVideoFile(const fs::path& file)
+{
+    static constexpr std::array<std::string_view, 6> extensions = {".mp4", ".avi", ".mkv",
+                                                                   ".mov", ".m4v", ".webm"};
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return std::find(extensions.begin(), extensions.end(), ext) != extensions.end();
+}
+
+} // namespace
+
+std::unique_ptr<FrameSource> openSource(const SourceOptions& options)
+{
+    const fs::path& input = options.input;
+    if (input.empty())
+        throw SourceError("no input given");
+    std::error_code ec;
+    if (!fs::exists(input, ec))
+        throw SourceError(fmt::format("input '{}' does not exist", input.string()));
+    if (options.depth && !fs::exists(*options.depth, ec))
+        throw SourceError(fmt::format("depth '{}' does not exist", options.depth->string()));
+    if (options.depthScale && !(*options.depthScale > 0.0 && std::isfinite(*options.depthScale)))
+        throw SourceError(fmt::format(
+            "depth scale must be a positive number of units per metre, got {}",
+            *options.depthScale));
+
+    if (fs::is_directory(input, ec)) {
+        if (fs::exists(input / "rgb.txt", ec) || fs::exists(input / "associations.txt", ec)) {
+            if (options.depth)
+                throw SourceError(fmt::format(
+                    "input '{}' is a TUM folder, which names its own depth files; drop the "
+                    "depth '{}'",
+                    input.string(), options.depth->string()));
+            return std::make_unique<TumSource>(input, options.depthScale.value_or(tumUnitsPerMetre));
+        }
+        return std::make_unique<FolderPairSource>(
+            input, options.depth, options.depthScale.value_or(defaultUnitsPerMetre));
+    }
+    if (fs::is_regular_file(input, ec)) {
+        const double scale = options.depthScale.value_or(defaultUnitsPerMetre);
+        if (isVideoFile(input))
+            return std::make_unique<VideoFileSource>(input, options.depth, scale);
+        if (options.depth && fs::is_directory(*options.depth, ec))
+            throw SourceError(fmt::format(
+                "input '{}' is one image but depth '{}' is a folder; give one depth image",
+                input.string(), options.depth->string()));
+        return std::make_unique<SingleImageSource>(input, options.depth, scale);
+    }
+    throw SourceError(
+        fmt::format("input '{}' is neither a folder nor a regular file", input.string()));
+}
+
+} // namespace defocus

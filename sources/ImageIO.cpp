@@ -1,0 +1,172 @@
+// Decodes colour and depth images from disk into the frame formats the filter expects
+// (colour: 8-bit sRGB or float linear BGR; depth: float metres).
+#include "sources/ImageIO.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "sources/FrameSource.hpp"
+
+namespace defocus {
+namespace {
+
+namespace fs = std::filesystem;
+
+// OpenCV reads OPENCV_IO_ENABLE_OPENEXR when it first decodes an EXR file, so setting it before
+// our first imread is enough. A value the user set (even "0") is left alone.
+void enableOpenExr()
+{
+    static const bool enabled = [] {
+        ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+        return true;
+    }();
+    (void)enabled;
+}
+
+std::string describeSamples(const cv::Mat& image)
+{
+    static constexpr const char* depthNames[] = {"8-bit unsigned", "8-bit signed", "16-bit unsigned",
+                                                 "16-bit signed",  "32-bit integer", "32-bit float",
+                                                 "64-bit float",   "16-bit float"};
+    const int channels = image.channels();
+    return fmt::format("{} with {} channel{}", depthNames[image.depth()], channels,
+                       channels == 1 ? "" : "s");
+}
+
+bool isFloat(const cv::Mat& image)
+{
+    return image.depth() == CV_32F || image.depth() == CV_64F || image.depth() == CV_16F;
+}
+
+// imread with IMREAD_UNCHANGED: the caller decides what each bit depth and channel count means.
+cv::Mat load(const fs::path& file, const char* what)
+{
+    enableOpenExr();
+    std::error_code ec;
+    if (!fs::exists(file, ec))
+        throw SourceError(
+            fmt::format("cannot read {} image '{}': file does not exist", what, file.string()));
+    if (fs::is_directory(file, ec))
+        throw SourceError(
+            fmt::format("cannot read {} image '{}': it is a folder", what, file.string()));
+    cv::Mat image;
+    try {
+        image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception& e) {
+        throw SourceError(fmt::format("cannot read {} image '{}': {}", what, file.string(), e.err));
+    }
+    if (image.empty())
+        throw SourceError(fmt::format(
+            "cannot read {} image '{}': not a decodable image (corrupt, truncated or an "
+            "unsupported format)",
+            what, file.string()));
+    return image;
+}
+
+// Grey -> BGR, BGRA -> BGR (alpha dropped); any depth cvtColor supports (8U, 16U, 32F).
+cv::Mat toBgr(const cv::Mat& image, const fs::path& file)
+{
+    cv::Mat bgr;
+    switch (image.channels()) {
+    case 1:
+        cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+        return bgr;
+    case 3:
+        return image;
+    case 4:
+        cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
+        return bgr;
+    default:
+        throw SourceError(fmt::format(
+            "cannot read colour image '{}': it is {}; expected 1 (grey), 3 (colour) or 4 "
+            "(colour + alpha) channels",
+            file.string(), describeSamples(image)));
+    }
+}
+
+// sRGB EOTF (IEC 61966-2-1), exact piecewise form, tabulated for every 16-bit code value:
+//   c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055)^2.4,   c = code / 65535.
+const std::vector<float>& srgb16ToLinear()
+{
+    static const std::vector<float> table = [] {
+        std::vector<float> t(65536);
+        for (std::size_t code = 0; code < t.size(); ++code) {
+            const double c = static_cast<double>(code) / 65535.0;
+            t[code] = static_cast<float>(c <= 0.04045 ? c / 12.92
+                                                      : std::pow((c + 0.055) / 1.055, 2.4));
+        }
+        return t;
+    }();
+    return table;
+}
+
+cv::Mat decode16BitSrgb(const cv::Mat& bgr16)
+{
+    const std::vector<float>& table = srgb16ToLinear();
+    cv::Mat linear(bgr16.size(), CV_32FC3);
+    const int valuesPerRow = bgr16.cols * 3;
+    for (int y = 0; y < bgr16.rows; ++y) {
+        const auto* in = bgr16.ptr<std::uint16_t>(y);
+        auto* out = linear.ptr<float>(y);
+        for (int i = 0; i < valuesPerRow; ++i)
+            out[i] = table[in[i]];
+    }
+    return linear;
+}
+
+} // namespace
+
+cv::Mat readColor(const fs::path& file)
+{
+    const cv::Mat raw = load(file, "colour");
+    if (raw.depth() == CV_8U)
+        return toBgr(raw, file);
+    if (raw.depth() == CV_16U)
+        return decode16BitSrgb(toBgr(raw, file));
+    if (isFloat(raw)) {
+        cv::Mat f;
+        raw.convertTo(f, CV_32F);
+        return toBgr(f, file);
+    }
+    throw SourceError(fmt::format(
+        "cannot read colour image '{}': it is {}; expected 8-bit, 16-bit or float samples",
+        file.string(), describeSamples(raw)));
+}
+
+cv::Mat readDepth(const fs::path& file, double unitsPerMetre)
+{
+    if (!(unitsPerMetre > 0.0) || !std::isfinite(unitsPerMetre))
+        throw SourceError(fmt::format(
+            "cannot read depth image '{}': the depth scale must be a positive number of units "
+            "per metre, got {}",
+            file.string(), unitsPerMetre));
+    const cv::Mat raw = load(file, "depth");
+    cv::Mat metres;
+    if (raw.depth() == CV_16U && raw.channels() == 1) {
+        // 0 (no measurement) stays 0.
+        raw.convertTo(metres, CV_32F, 1.0 / unitsPerMetre);
+        return metres;
+    }
+    if (isFloat(raw) && (raw.channels() == 1 || raw.channels() == 3 || raw.channels() == 4)) {
+        // Renderers often store depth replicated in R, G and B: take the first channel.
+        cv::Mat first = raw;
+        if (raw.channels() > 1)
+            cv::extractChannel(raw, first, 0);
+        first.convertTo(metres, CV_32F);
+        return metres;
+    }
+    throw SourceError(fmt::format(
+        "cannot read depth image '{}': it is {}; expected 16-bit single-channel ({} units per "
+        "metre) or float metres (EXR, TIFF)",
+        file.string(), describeSamples(raw), unitsPerMetre));
+}
+
+} // namespace defocus

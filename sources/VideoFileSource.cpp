@@ -1,0 +1,101 @@
+// Video file source: decodes frames with cv::VideoCapture and attaches the optional shared depth.
+#include "sources/VideoFileSource.hpp"
+
+#include <cmath>
+#include <system_error>
+#include <utility>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+#include "sources/ImageIO.hpp"
+
+namespace defocus {
+
+VideoFileSource::VideoFileSource(std::filesystem::path file,
+                                 std::optional<std::filesystem::path> depthFile,
+                                 double unitsPerMetre)
+    : file_(std::move(file)), depthFile_(std::move(depthFile))
+{
+    std::error_code ec;
+    if (depthFile_ && std::filesystem::is_directory(*depthFile_, ec))
+        throw SourceError(fmt::format(
+            "video '{}': depth '{}' is a folder; a video takes one depth image for all frames",
+            file_.string(), depthFile_->string()));
+    try {
+        capture_.open(file_.string(), cv::CAP_ANY);
+    } catch (const cv::Exception& e) {
+        throw SourceError(fmt::format("cannot open video '{}': {}", file_.string(), e.err));
+    }
+    if (!capture_.isOpened())
+        throw SourceError(fmt::format(
+            "cannot open video '{}': no video backend could decode it (corrupt file or missing "
+            "codec)",
+            file_.string()));
+    const double fps = capture_.get(cv::CAP_PROP_FPS);
+    frameRate_ = std::isfinite(fps) && fps > 0.0 ? fps : 0.0;
+    const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+    if (std::isfinite(count) && count >= 1.0)
+        frameCount_ = static_cast<std::size_t>(count);
+    if (depthFile_)
+        depth_ = readDepth(*depthFile_, unitsPerMetre);
+    else
+        spdlog::warn("video '{}': no depth given; its frames pass through in focus",
+                     file_.string());
+}
+
+std::optional<Frame> VideoFileSource::next()
+{
+    if (ended_)
+        return std::nullopt;
+    cv::Mat image;
+    bool read = false;
+    try {
+        read = capture_.read(image);
+    } catch (const cv::Exception& e) {
+        throw SourceError(
+            fmt::format("video '{}': cannot decode frame {}: {}", file_.string(), next_, e.err));
+    }
+    if (!read || image.empty()) {
+        ended_ = true;
+        capture_.release();
+        return std::nullopt;
+    }
+    Frame frame;
+    if (image.type() == CV_8UC3)
+        frame.color = image;
+    else if (image.type() == CV_8UC1)
+        cv::cvtColor(image, frame.color, cv::COLOR_GRAY2BGR);
+    else if (image.type() == CV_8UC4)
+        cv::cvtColor(image, frame.color, cv::COLOR_BGRA2BGR);
+    else
+        throw SourceError(fmt::format("video '{}': frame {} has unsupported pixel type {}",
+                                      file_.string(), next_, cv::typeToString(image.type())));
+    if (!depth_.empty())
+        frame.depth = depth_.clone(); // each frame owns its pixels
+    const double msec = capture_.get(cv::CAP_PROP_POS_MSEC);
+    frame.timestamp = std::isfinite(msec) && msec >= 0.0 ? msec / 1000.0
+                      : frameRate_ > 0.0                  ? static_cast<double>(next_) / frameRate_
+                                                          : 0.0;
+    frame.index = next_;
+    frame.name = fmt::format("{}#{}", file_.filename().string(), next_);
+    ++next_;
+    return frame;
+}
+
+std::optional<std::size_t> VideoFileSource::frameCount() const
+{
+    return frameCount_;
+}
+
+std::string VideoFileSource::describe() const
+{
+    return fmt::format("video '{}' ({}{:.3g} fps, {})", file_.string(),
+                       frameCount_ ? fmt::format("{} frames, ", *frameCount_) : std::string(),
+                       frameRate_,
+                       depthFile_ ? fmt::format("depth '{}'", depthFile_->string())
+                                  : std::string("no depth"));
+}
+
+} // namespace defocus

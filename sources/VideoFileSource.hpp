@@ -1,0 +1,41 @@
+// A video file decoded by cv::VideoCapture: colour only, with an optional single depth image
+// applied to every frame.   defocus clip.mp4 --depth depth.png -o out.mp4
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include <opencv2/videoio.hpp>
+
+#include "sources/FrameSource.hpp"
+
+namespace defocus {
+
+class VideoFileSource final : public FrameSource {
+public:
+    /// Opens the container at once (SourceError naming the file when no backend decodes it).
+    /// `depthFile`: one depth image for every frame (a static camera), or none: frames pass
+    /// through in focus. A depth folder is rejected: per-frame depth for video is not supported.
+    VideoFileSource(std::filesystem::path file, std::optional<std::filesystem::path> depthFile,
+                    double unitsPerMetre);
+
+    std::optional<Frame> next() override;
+    /// The container's frame count, when it states one (it may be an estimate).
+    std::optional<std::size_t> frameCount() const override;
+    double frameRate() const override { return frameRate_; }
+    std::string describe() const override;
+
+private:
+    std::filesystem::path file_;
+    std::optional<std::filesystem::path> depthFile_;
+    cv::VideoCapture capture_;
+    cv::Mat depth_;
+    double frameRate_ = 0.0;
+    std::optional<std::size_t> frameCount_;
+    std::size_t next_ = 0;
+    bool ended_ = false;
+};
+
+} // namespace defocus

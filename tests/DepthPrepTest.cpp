@@ -1,0 +1,82 @@
+// Depth preparation without GL: nearest resize, push-pull hole filling, centre depth.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "filter/DepthPrep.hpp"
+
+namespace defocus {
+namespace {
+
+TEST(DepthPrep, ValidPixelsAreKeptExactlyAndHolesFilledFromNeighbours)
+{
+    cv::Mat depth(40, 60, CV_32F, cv::Scalar(2.0f));
+    depth(cv::Rect(30, 0, 30, 40)).setTo(4.0f);
+    depth.at<float>(10, 10) = 0.0f;                                      // hole in the 2 m side
+    depth.at<float>(11, 10) = std::numeric_limits<float>::quiet_NaN();   // NaN
+    depth.at<float>(20, 45) = -1.0f;                                     // negative, 4 m side
+    depth.at<float>(21, 45) = std::numeric_limits<float>::infinity();
+    depth.at<float>(22, 45) = 1e-40f;                                    // denormal
+    const auto prepared = prepareDepth(depth, depth.size(), 9.0f);
+    EXPECT_NEAR(prepared.invalidFraction, 5.0 / (40.0 * 60.0), 1e-12);
+    EXPECT_TRUE(cv::checkRange(prepared.metres, true, nullptr, kMinValidDepthM, 1e30));
+    // Far from the 2|4 m edge a hole sees only its own side (push-pull averages neighbours).
+    EXPECT_NEAR(prepared.metres.at<float>(10, 10), 2.0f, 1e-4f);
+    EXPECT_NEAR(prepared.metres.at<float>(11, 10), 2.0f, 1e-4f);
+    EXPECT_NEAR(prepared.metres.at<float>(21, 45), 4.0f, 1e-4f);
+    EXPECT_EQ(prepared.metres.at<float>(5, 5), 2.0f);
+    EXPECT_EQ(prepared.metres.at<float>(5, 50), 4.0f);
+}
+
+TEST(DepthPrep, LargeHoleIsFilledWithValuesBetweenItsBorders)
+{
+    cv::Mat depth(64, 64, CV_32F);
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x)
+            depth.at<float>(y, x) = 1.0f + static_cast<float>(x) / 32.0f; // 1..3 m ramp
+    depth(cv::Rect(16, 16, 32, 32)).setTo(0.0f);
+    const auto prepared = prepareDepth(depth, depth.size(), 9.0f);
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(prepared.metres(cv::Rect(16, 16, 32, 32)), &lo, &hi);
+    EXPECT_GE(lo, 1.0 + 15.0 / 32.0 - 1e-3);
+    EXPECT_LE(hi, 1.0 + 48.0 / 32.0 + 1e-3);
+}
+
+TEST(DepthPrep, ResizeIsNearestSoNoDepthIsInventedAcrossEdges)
+{
+    cv::Mat depth(24, 32, CV_32F, cv::Scalar(1.0f));
+    depth(cv::Rect(16, 0, 16, 24)).setTo(10.0f);
+    const auto prepared = prepareDepth(depth, {640, 480}, 5.0f);
+    ASSERT_EQ(prepared.metres.size(), cv::Size(640, 480));
+    for (int y = 0; y < 480; y += 7)
+        for (int x = 0; x < 640; x += 3) {
+            const float z = prepared.metres.at<float>(y, x);
+            EXPECT_TRUE(z == 1.0f || z == 10.0f) << z;
+        }
+}
+
+TEST(DepthPrep, NoValidDepthGivesTheFallback)
+{
+    cv::Mat depth(10, 10, CV_32F, cv::Scalar(0.0f));
+    const auto prepared = prepareDepth(depth, depth.size(), 3.5f);
+    EXPECT_EQ(prepared.invalidFraction, 1.0);
+    EXPECT_EQ(cv::countNonZero(prepared.metres != 3.5f), 0);
+    const auto none = prepareDepth(cv::Mat(), {8, 6}, 3.5f);
+    EXPECT_EQ(none.metres.size(), cv::Size(8, 6));
+    EXPECT_EQ(cv::countNonZero(none.metres != 3.5f), 0);
+}
+
+TEST(DepthPrep, CentreDepthIsTheMedianOfValidCentrePixels)
+{
+    cv::Mat depth(100, 100, CV_32F, cv::Scalar(9.0f));
+    depth(cv::Rect(45, 45, 10, 10)).setTo(1.5f);
+    depth.at<float>(50, 50) = 0.0f;
+    EXPECT_FLOAT_EQ(centreDepth(depth, 0.1, 7.0f), 1.5f);
+    depth(cv::Rect(45, 45, 10, 10)).setTo(0.0f);
+    EXPECT_FLOAT_EQ(centreDepth(depth, 0.1, 7.0f), 7.0f);
+}
+
+} // namespace
+} // namespace defocus

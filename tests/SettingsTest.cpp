@@ -1,0 +1,75 @@
+// Parameter validation: one place, messages naming parameter, value and range; clamping.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "filter/Settings.hpp"
+
+namespace defocus {
+namespace {
+
+TEST(Settings, DefaultsAreValid)
+{
+    LensSettings lens;
+    QualitySettings quality;
+    EXPECT_TRUE(validate(lens).empty());
+    EXPECT_TRUE(validate(quality).empty());
+}
+
+TEST(Settings, MessageNamesParameterValueAndRange)
+{
+    LensSettings lens;
+    lens.fNumber = 0.5;
+    const auto issues = validate(lens);
+    ASSERT_EQ(issues.size(), 1u);
+    EXPECT_EQ(issues[0].parameter, "--f-number");
+    EXPECT_NE(issues[0].message.find("0.5"), std::string::npos);
+    EXPECT_NE(issues[0].message.find("[0.7, 64]"), std::string::npos);
+    EXPECT_DOUBLE_EQ(lens.fNumber, 0.5) << "without clamp the value is left alone";
+}
+
+TEST(Settings, FocusMustBeBeyondFocalLength)
+{
+    LensSettings lens;
+    lens.focalLengthMm = 50.0;
+    lens.focusM = 0.05; // equal to the focal length
+    ASSERT_EQ(validate(lens).size(), 1u);
+    lens.focusM = 0.01; // below it
+    ASSERT_EQ(validate(lens).size(), 1u);
+    lens.focusM = std::numeric_limits<double>::infinity();
+    EXPECT_TRUE(validate(lens).empty());
+}
+
+TEST(Settings, ClampModeFixesEveryValueAndStillReports)
+{
+    LensSettings lens;
+    lens.fNumber = 100.0;
+    lens.focalLengthMm = 0.1;
+    lens.maxCocPx = -3.0;
+    lens.sensorWidthMm = std::nan("");
+    QualitySettings quality;
+    quality.samples = 1000;
+    EXPECT_EQ(validate(lens, true).size(), 4u);
+    EXPECT_EQ(validate(quality, true).size(), 1u);
+    EXPECT_DOUBLE_EQ(lens.fNumber, 64.0);
+    EXPECT_DOUBLE_EQ(lens.focalLengthMm, 1.0);
+    EXPECT_DOUBLE_EQ(lens.maxCocPx, 0.0);
+    EXPECT_DOUBLE_EQ(lens.sensorWidthMm, 1.0);
+    EXPECT_EQ(quality.samples, 64);
+    EXPECT_TRUE(validate(lens).empty());
+    EXPECT_TRUE(validate(quality).empty());
+}
+
+TEST(Settings, ViewNamesRoundTrip)
+{
+    for (const View v : kAllViews) {
+        View parsed = View::Input;
+        ASSERT_TRUE(parseView(viewName(v), parsed));
+        EXPECT_EQ(parsed, v);
+    }
+    View unused{};
+    EXPECT_FALSE(parseView("blurry", unused));
+}
+
+} // namespace
+} // namespace defocus

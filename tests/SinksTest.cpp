@@ -1,0 +1,240 @@
+// Frame sinks: numbered sequences, videos read back with cv::VideoCapture, single images, and the
+// errors for bad outputs.
+#include <algorithm>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "sinks/FrameSink.hpp"
+#include "tests/TestSupport.hpp"
+
+namespace defocus {
+namespace {
+
+namespace fs = std::filesystem;
+
+cv::Mat readBack(const fs::path& file)
+{
+    ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+    return cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+}
+
+// A frame that differs per index and has structure (a gradient), so a wrong or repeated frame
+// shows up.
+cv::Mat testFrame(int index, cv::Size size = {64, 48})
+{
+    cv::Mat frame(size, CV_8UC3);
+    for (int y = 0; y < size.height; ++y)
+        for (int x = 0; x < size.width; ++x)
+            frame.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<uchar>(30 * index + 20),
+                                                  static_cast<uchar>(2 * x + 40),
+                                                  static_cast<uchar>(3 * y + 30));
+    return frame;
+}
+
+std::vector<std::string> fileNames(const fs::path& dir)
+{
+    std::vector<std::string> names;
+    for (const fs::directory_entry& entry : fs::directory_iterator(dir))
+        names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+std::string openError(const SinkOptions& options)
+{
+    try {
+        openSink(options);
+    } catch (const SinkError& e) {
+        return e.what();
+    }
+    ADD_FAILURE() << "openSink(" << options.output << ") did not throw SinkError";
+    return {};
+}
+
+TEST(ImageSequenceSink, WritesNumberedPngsAndNothingElse)
+{
+    const fs::path dir = test::scratchDir("Sink_sequence") / "out";
+    const std::unique_ptr<FrameSink> sink = openSink({dir.string() + "/", 30.0, false});
+    EXPECT_TRUE(fs::is_directory(dir)); // created at open
+    EXPECT_EQ(sink->encoding(), SinkEncoding::Srgb8);
+    for (int k = 0; k < 3; ++k)
+        sink->write(testFrame(k));
+    sink->finish();
+    EXPECT_EQ(sink->framesWritten(), 3u);
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"frame_000000.png", "frame_000001.png",
+                                                        "frame_000002.png"}));
+    for (int k = 0; k < 3; ++k) {
+        const cv::Mat back = readBack(dir / fmt::format("frame_{:06}.png", k));
+        ASSERT_EQ(back.type(), CV_8UC3);
+        EXPECT_EQ(cv::norm(back, testFrame(k), cv::NORM_INF), 0.0); // PNG is lossless
+    }
+}
+
+TEST(ImageSequenceSink, ExistingFolderWithoutSlashAndLinearExrSequence)
+{
+    const fs::path dir = test::scratchDir("Sink_sequence_exr");
+    const std::unique_ptr<FrameSink> sink = openSink({dir, 30.0, true});
+    EXPECT_EQ(sink->encoding(), SinkEncoding::Linear32F);
+    const cv::Mat hdr(8, 8, CV_32FC3, cv::Scalar(0.5, 4.0, 80.0));
+    sink->write(hdr);
+    sink->write(hdr * 2.0);
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"frame_000000.exr", "frame_000001.exr"}));
+    const cv::Mat back = readBack(dir / "frame_000001.exr");
+    ASSERT_EQ(back.type(), CV_32FC3);
+    EXPECT_EQ(back.at<cv::Vec3f>(7, 7), cv::Vec3f(1.0f, 8.0f, 160.0f));
+}
+
+TEST(ImageSequenceSink, WrongFrameTypeIsASinkError)
+{
+    const fs::path dir = test::scratchDir("Sink_sequence_type");
+    const std::unique_ptr<FrameSink> sink = openSink({dir, 30.0, false});
+    EXPECT_THROW(sink->write(cv::Mat(4, 4, CV_32FC3)), SinkError);
+    EXPECT_THROW(sink->write(cv::Mat()), SinkError);
+    EXPECT_EQ(sink->framesWritten(), 0u);
+}
+
+// Writes `count` frames and reads the file back: frame count, size and (lossy) content.
+void checkVideoRoundTrip(const std::string& extension, const std::string& expectedCodec)
+{
+    const fs::path dir = test::scratchDir("Sink_video_" + extension);
+    const fs::path file = dir / ("clip." + extension);
+    constexpr int count = 7;
+    {
+        const std::unique_ptr<FrameSink> sink = openSink({file, 24.0, false});
+        EXPECT_EQ(sink->encoding(), SinkEncoding::Srgb8);
+        if (!expectedCodec.empty()) {
+            EXPECT_NE(sink->describe().find(expectedCodec), std::string::npos)
+                << sink->describe();
+        }
+        for (int k = 0; k < count; ++k)
+            sink->write(testFrame(k));
+        EXPECT_EQ(sink->framesWritten(), static_cast<std::size_t>(count));
+        EXPECT_FALSE(fs::exists(file)); // still the partial file until finish()
+        sink->finish();
+        sink->finish(); // idempotent
+    }
+    EXPECT_EQ(fileNames(dir), std::vector<std::string>{"clip." + extension});
+
+    cv::VideoCapture capture(file.string());
+    ASSERT_TRUE(capture.isOpened()) << file;
+    EXPECT_NEAR(capture.get(cv::CAP_PROP_FPS), 24.0, 0.01);
+    int read = 0;
+    for (cv::Mat frame; capture.read(frame); ++read) {
+        ASSERT_EQ(frame.size(), cv::Size(64, 48));
+        // Lossy codecs: compare means. Consecutive frames differ by 30 in blue, so a tolerance of
+        // 8 still tells every frame apart.
+        const cv::Scalar got = cv::mean(frame);
+        const cv::Scalar want = cv::mean(testFrame(read));
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(got[c], want[c], 8.0) << "frame " << read << " channel " << c;
+    }
+    EXPECT_EQ(read, count);
+}
+
+TEST(VideoSink, Mp4WithMp4vReadsBackEveryFrame)
+{
+    checkVideoRoundTrip("mp4", "mp4v");
+}
+
+TEST(VideoSink, AviWithMjpgReadsBackEveryFrame)
+{
+    checkVideoRoundTrip("avi", "MJPG");
+}
+
+TEST(VideoSink, MkvReadsBackEveryFrame)
+{
+    checkVideoRoundTrip("mkv", ""); // X264 where libx264 exists, else a fallback
+}
+
+TEST(VideoSink, FrameOfAnotherSizeIsASinkError)
+{
+    const fs::path file = test::scratchDir("Sink_video_size") / "clip.mp4";
+    const std::unique_ptr<FrameSink> sink = openSink({file, 30.0, false});
+    sink->write(testFrame(0));
+    try {
+        sink->write(testFrame(1, {32, 48}));
+        ADD_FAILURE() << "no SinkError for a frame of another size";
+    } catch (const SinkError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+        EXPECT_NE(message.find("32x48"), std::string::npos) << message;
+        EXPECT_NE(message.find("64x48"), std::string::npos) << message;
+    }
+    EXPECT_THROW(sink->write(cv::Mat(48, 64, CV_32FC3)), SinkError);
+    EXPECT_EQ(sink->framesWritten(), 1u);
+}
+
+TEST(VideoSink, DestructorFinishesTheFile)
+{
+    const fs::path file = test::scratchDir("Sink_video_dtor") / "clip.avi";
+    {
+        const std::unique_ptr<FrameSink> sink = openSink({file, 30.0, false});
+        sink->write(testFrame(0));
+        sink->write(testFrame(1));
+    }
+    cv::VideoCapture capture(file.string());
+    ASSERT_TRUE(capture.isOpened());
+    int read = 0;
+    for (cv::Mat frame; capture.read(frame);)
+        ++read;
+    EXPECT_EQ(read, 2);
+}
+
+TEST(VideoSink, NoFramesLeavesNoFile)
+{
+    const fs::path dir = test::scratchDir("Sink_video_empty");
+    openSink({dir / "clip.mp4", 30.0, false})->finish();
+    EXPECT_TRUE(fileNames(dir).empty());
+}
+
+TEST(SingleImageSink, PngHoldsTheLastFrameWritten)
+{
+    const fs::path dir = test::scratchDir("Sink_single_png");
+    const fs::path file = dir / "nested" / "out.png";
+    const std::unique_ptr<FrameSink> sink = openSink({file, 30.0, false});
+    EXPECT_EQ(sink->encoding(), SinkEncoding::Srgb8);
+    sink->write(testFrame(0));
+    sink->write(testFrame(1));
+    sink->finish();
+    EXPECT_EQ(sink->framesWritten(), 2u);
+    EXPECT_EQ(fileNames(file.parent_path()), std::vector<std::string>{"out.png"}); // no temp left
+    const cv::Mat back = readBack(file);
+    ASSERT_EQ(back.type(), CV_8UC3);
+    EXPECT_EQ(cv::norm(back, testFrame(1), cv::NORM_INF), 0.0);
+}
+
+TEST(SingleImageSink, ExrKeepsValuesAboveOneUnclipped)
+{
+    const fs::path file = test::scratchDir("Sink_single_exr") / "out.exr";
+    const std::unique_ptr<FrameSink> sink = openSink({file, 30.0, false});
+    EXPECT_EQ(sink->encoding(), SinkEncoding::Linear32F);
+    cv::Mat hdr(5, 7, CV_32FC3, cv::Scalar(0.001, 1.0, 80.0));
+    hdr.at<cv::Vec3f>(2, 3) = cv::Vec3f(1234.5f, 0.0f, 3.25f);
+    sink->write(hdr);
+    const cv::Mat back = readBack(file);
+    ASSERT_EQ(back.type(), CV_32FC3);
+    EXPECT_EQ(cv::norm(back, hdr, cv::NORM_INF), 0.0); // 32-bit float EXR is exact
+    EXPECT_THROW(sink->write(cv::Mat(5, 7, CV_8UC3)), SinkError);
+}
+
+TEST(OpenSink, UnknownOrMissingExtensionIsASinkError)
+{
+    const fs::path dir = test::scratchDir("Sink_errors");
+    const std::string unknown = openError({dir / "out.gif", 30.0, false});
+    EXPECT_NE(unknown.find((dir / "out.gif").string()), std::string::npos) << unknown;
+    EXPECT_NE(unknown.find(".gif"), std::string::npos) << unknown;
+    const std::string none = openError({dir / "out", 30.0, false});
+    EXPECT_NE(none.find("no extension"), std::string::npos) << none;
+    const std::string fps = openError({dir / "out.mp4", 0.0, false});
+    EXPECT_NE(fps.find("frame rate"), std::string::npos) << fps;
+    EXPECT_TRUE(fileNames(dir).empty());
+}
+
+} // namespace
+} // namespace defocus
