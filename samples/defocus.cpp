@@ -93,14 +93,14 @@ int run(const Options& options)
     View view = View::Composite;
     parseView(options.view, view); // validated by CLI11's check
 
+    SinkOptions sinkOptions{options.output, options.fps.value_or(source->frameRate() > 0 ? source->frameRate() : 30.0),
+                            false};
+    auto sink = openSink(sinkOptions);
+
     auto context = gl::EglContext::create();
     Pipeline pipeline;
     if (!options.quiet)
         spdlog::info("{} -> {} on {}", source->describe(), options.output, context.info().glRenderer);
-
-    SinkOptions sinkOptions{options.output, options.fps.value_or(source->frameRate() > 0 ? source->frameRate() : 30.0),
-                            false};
-    auto sink = openSink(sinkOptions);
     const Encoding encoding = sink->encoding() == SinkEncoding::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
 
     std::optional<std::size_t> total = source->frameCount();

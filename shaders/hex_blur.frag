@@ -24,7 +24,19 @@ layout(std140, binding = 0) uniform HexBlurParams {
     float bleedingBias;
     float bleedingMult;
     float cocToPaperUnits;     // 1 / image height in pixels
+    float maxTapSpacing;       // pixels; small CoCs use every stride-th tap while taps stay this close
 };
+
+// The largest stride dividing sampleCount - 1 (so the taps used stay symmetric and still span
+// the whole diameter) that keeps neighbouring taps at most maxTapSpacing pixels apart.
+int tapStride(float diameter)
+{
+    const int intervals = sampleCount - 1;
+    for (int stride = intervals; stride > 1; --stride)
+        if (intervals % stride == 0 && diameter * float(stride) <= maxTapSpacing * float(intervals))
+            return stride;
+    return 1;
+}
 
 void main()
 {
@@ -39,7 +51,8 @@ void main()
 
     vec4 sum = vec4(0.0);
     float totalWeight = 0.0;
-    for (int i = 0; i < sampleCount; ++i) {
+    const int stride = tapStride(diameter);
+    for (int i = 0; i < sampleCount; i += stride) {
         const vec2 coords = vUv + offsets[i].xy * diameter;
         const vec4 tap = textureLod(uSource, coords, 0.0);
         const float tapDepth = textureLod(uDepth, coords, 0.0).r;

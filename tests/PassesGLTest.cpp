@@ -153,6 +153,32 @@ TEST_F(Passes, CocTargetIsSignedNearNegativeFarPositive)
     EXPECT_GT(channels[3].at<float>(10, 30), 0.0f);
 }
 
+TEST_F(Passes, HdrEnergyIsKeptThroughTheLinearPath)
+{
+    // Scene-linear input far above 1: a blurred constant field stays at its value (a convex
+    // combination of equal values), and a bright square keeps its total energy within the
+    // hexagon-vs-rhombus loss of the min() composite.
+    cv::Mat color(64, 64, CV_32FC3, cv::Scalar::all(50.0));
+    Pipeline pipeline;
+    cv::Mat out = pipeline.run({color, cv::Mat(color.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "hdr"},
+                               lensWithFarCoc(12.0), {}, View::Composite, Encoding::Linear32F);
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(out.reshape(1), &lo, &hi);
+    // Half-float targets hold 50 to 11 bits: 50 * 2^-11 = 0.025.
+    EXPECT_NEAR(lo, 50.0, 0.05);
+    EXPECT_NEAR(hi, 50.0, 0.05);
+
+    color.setTo(cv::Scalar::all(0.0));
+    color(cv::Rect(28, 28, 8, 8)).setTo(cv::Scalar::all(1e4));
+    out = pipeline.run({color, cv::Mat(color.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "hdr"},
+                       lensWithFarCoc(12.0), {}, View::Composite, Encoding::Linear32F);
+    const double energyIn = cv::sum(color)[0], energyOut = cv::sum(out)[0];
+    EXPECT_GT(energyOut, 0.6 * energyIn);
+    EXPECT_LE(energyOut, 1.01 * energyIn);
+    cv::minMaxLoc(out.reshape(1), nullptr, &hi);
+    EXPECT_GT(hi, 1000.0) << "the highlight stays HDR, it is not clipped to 1";
+}
+
 TEST_F(Passes, EveryViewRendersAtTheFrameSize)
 {
     cv::Mat color(48, 200, CV_8UC3, cv::Scalar(20, 120, 220));

@@ -48,6 +48,7 @@ void HexBlurPass::run(const gl::Texture& source, const gl::Texture& depth, float
     u.bleedingBias = kBleedingBias;
     u.bleedingMult = kBleedingMult;
     u.cocToPaperUnits = 1.0f / static_cast<float>(target.height());
+    u.maxTapSpacing = kMaxTapSpacingPx;
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();

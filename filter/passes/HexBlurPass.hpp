@@ -16,6 +16,9 @@ public:
     /// The paper's bleeding fix constants, in its unit (CoC as a fraction of image height).
     static constexpr float kBleedingBias = 0.02f;
     static constexpr float kBleedingMult = 30.0f;
+    /// Taps of a small CoC are thinned while neighbours stay this close (pixels): more taps
+    /// than that only resample the same bilinear footprints.
+    static constexpr float kMaxTapSpacingPx = 1.5f;
 
     HexBlurPass();
     /// Blurs `source` (rgb + signed CoC) along `angleDegrees` (counter-clockwise on screen, 0 =
@@ -35,6 +38,7 @@ private:
         float bleedingBias;
         float bleedingMult;
         float cocToPaperUnits;
+        float maxTapSpacing;
     };
     gl::Program program_;
     gl::UniformBuffer uniforms_;
