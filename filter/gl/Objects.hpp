@@ -2,6 +2,7 @@
 // moving leaves the source empty. Each object can carry a debug label (GL_KHR_debug).
 #pragma once
 
+#include <atomic>
 #include <string_view>
 #include <utility>
 
@@ -9,12 +10,20 @@
 
 namespace defocus::gl {
 
+/// GL objects currently owned by Handles, all kinds together: flat over a long run means
+/// nothing leaks (the soak test checks it).
+inline std::atomic<long> liveObjects{0};
+
 /// Shared ownership logic: `Deleter` frees one id.
 template <void (*Deleter)(GLuint)>
 class Handle {
 public:
     Handle() = default;
-    explicit Handle(GLuint id) : id_(id) {}
+    explicit Handle(GLuint id) : id_(id)
+    {
+        if (id_ != 0)
+            ++liveObjects;
+    }
     Handle(Handle&& other) noexcept : id_(std::exchange(other.id_, 0)) {}
     Handle& operator=(Handle&& other) noexcept
     {
@@ -32,8 +41,10 @@ public:
     explicit operator bool() const { return id_ != 0; }
     void reset()
     {
-        if (id_ != 0)
+        if (id_ != 0) {
             Deleter(std::exchange(id_, 0));
+            --liveObjects;
+        }
     }
 
 private:

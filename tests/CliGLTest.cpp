@@ -1,0 +1,148 @@
+// The defocus program end to end: Ctrl-C (SIGINT) and SIGTERM finalise what was written, and
+// every input frame gives an output frame.
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <opencv2/videoio.hpp>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include "tests/GLTestSupport.hpp"
+#include "tests/TestSupport.hpp"
+
+extern char** environ;
+
+namespace defocus {
+namespace {
+
+namespace fs = std::filesystem;
+
+class Cli : public test::GLTest {};
+
+/// A folder pair of `count` frames made of links to the bundled TUM pairs, in order.
+fs::path longClip(const std::string& name, int count)
+{
+    const fs::path dir = test::scratchDir(name);
+    fs::create_directories(dir / "rgb");
+    fs::create_directories(dir / "depth");
+    std::vector<fs::path> rgb, depth;
+    for (const auto& e : fs::directory_iterator(test::dataDir() / "tum_fr1_rpy" / "rgb"))
+        rgb.push_back(e.path());
+    for (const auto& e : fs::directory_iterator(test::dataDir() / "tum_fr1_rpy" / "depth"))
+        depth.push_back(e.path());
+    std::sort(rgb.begin(), rgb.end());
+    std::sort(depth.begin(), depth.end());
+    for (int i = 0; i < count; ++i) {
+        const auto n = static_cast<std::size_t>(i) % rgb.size();
+        char stem[32];
+        std::snprintf(stem, sizeof stem, "%05d.png", i);
+        fs::create_symlink(rgb[n], dir / "rgb" / stem);
+        fs::create_symlink(depth[n], dir / "depth" / stem);
+    }
+    return dir;
+}
+
+struct ProgramRun {
+    int exitCode = -1;
+    std::string output;
+};
+
+/// Runs defocus with `args`, sends `signal` once `ready()` is true (0: never), and waits.
+template <typename Ready>
+ProgramRun runDefocus(const std::vector<std::string>& args, int signal, Ready ready, const fs::path& log)
+{
+    std::vector<std::string> all{std::string(DEFOCUS_BINARY_DIR) + "/defocus"};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : all)
+        argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    pid_t pid = 0;
+    EXPECT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+    int status = 0;
+    bool exited = false;
+    if (signal != 0) {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+        while (!ready() && std::chrono::steady_clock::now() < deadline && !exited) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(50));
+            exited = waitpid(pid, &status, WNOHANG) == pid;
+        }
+        if (!exited)
+            kill(pid, signal);
+    }
+    if (!exited)
+        waitpid(pid, &status, 0);
+    ProgramRun run;
+    run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    std::ifstream in(log);
+    run.output.assign(std::istreambuf_iterator<char>(in), {});
+    return run;
+}
+
+/// "N frames out" from the summary line.
+long framesOut(const std::string& output)
+{
+    const auto at = output.find(" frames out");
+    if (at == std::string::npos)
+        return -1;
+    const auto start = output.rfind(' ', at - 1);
+    return std::stol(output.substr(start + 1, at - start - 1));
+}
+
+class Interrupt : public Cli, public ::testing::WithParamInterface<int> {};
+
+TEST_P(Interrupt, VideoWrittenSoFarIsFinalisedAndPlayable)
+{
+    const fs::path clip = longClip("interrupt_clip", 200);
+    const fs::path out = test::scratchDir("interrupt_out") / "clip.mp4";
+    const fs::path partial = out.parent_path() / "clip.partial.mp4";
+    // Signal once a few frames are in the container.
+    const ProgramRun run = runDefocus({(clip / "rgb").string(), "--depth", (clip / "depth").string(), "--depth-scale", "5000", "-o",
+                                out.string(), "--focus", "1"},
+                               GetParam(), [&] { return fs::exists(partial) && fs::file_size(partial) > 20000; },
+                               out.parent_path() / "log.txt");
+    EXPECT_EQ(run.exitCode, 130) << run.output;
+    ASSERT_TRUE(fs::exists(out)) << run.output;
+    EXPECT_FALSE(fs::exists(partial));
+    const long written = framesOut(run.output);
+    EXPECT_GT(written, 0) << run.output;
+    EXPECT_LT(written, 200) << "the signal came before the end";
+    cv::VideoCapture video(out.string());
+    ASSERT_TRUE(video.isOpened());
+    long decoded = 0;
+    cv::Mat frame;
+    while (video.read(frame))
+        ++decoded;
+    EXPECT_EQ(decoded, written) << "every frame counted as written must play back";
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM),
+                         [](const auto& param) { return param.param == SIGINT ? "SIGINT" : "SIGTERM"; });
+
+TEST_F(Cli, EveryInputFrameGivesAnOutputFrame)
+{
+    const fs::path out = test::scratchDir("cli_sequence");
+    const ProgramRun run = runDefocus({(test::dataDir() / "tum_fr1_rpy").string(), "-o", (out / "frames/").string(), "-q"}, 0,
+                               [] { return true; }, out / "log.txt");
+    EXPECT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("10 frames in, 10 frames out"), std::string::npos) << run.output;
+    long files = 0;
+    for (const auto& e : fs::directory_iterator(out / "frames"))
+        files += e.path().extension() == ".png" ? 1 : 0;
+    EXPECT_EQ(files, 10);
+}
+
+} // namespace
+} // namespace defocus
