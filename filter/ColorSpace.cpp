@@ -36,6 +36,19 @@ cv::Mat decodeSrgb(const cv::Mat& srgb8)
     return out;
 }
 
+cv::Mat sanitizeLinear(const cv::Mat& linear, float largest)
+{
+    CV_Assert(linear.type() == CV_32FC3);
+    cv::Mat out(linear.size(), CV_32FC3);
+    for (int y = 0; y < linear.rows; ++y) {
+        const auto* in = linear.ptr<float>(y);
+        auto* o = out.ptr<float>(y);
+        for (int x = 0; x < linear.cols * 3; ++x)
+            o[x] = std::isnan(in[x]) ? 0.0f : std::clamp(in[x], 0.0f, largest);
+    }
+    return out;
+}
+
 cv::Mat encodeSrgb(const cv::Mat& linear)
 {
     CV_Assert(linear.type() == CV_32FC3);

@@ -11,6 +11,8 @@ float srgbToLinear(float v);
 float linearToSrgb(float v);
 /// CV_8UC3 sRGB -> CV_32FC3 linear.
 cv::Mat decodeSrgb(const cv::Mat& srgb8);
+/// CV_32FC3 linear, made what the CoC pass makes of it: NaN -> 0, then clamped to [0, largest].
+cv::Mat sanitizeLinear(const cv::Mat& linear, float largest);
 /// CV_32FC3 linear -> CV_8UC3 sRGB, clipped to [0, 1] and rounded.
 cv::Mat encodeSrgb(const cv::Mat& linear);
 

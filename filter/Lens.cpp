@@ -35,10 +35,16 @@ CocCoefficients cocCoefficients(const LensSettings& lens, int imageWidthPx)
     } else {
         // Linear ramps in z: c = -max (S1 - z) / (S1 - near) in front, max (z - S1) / (far - S1)
         // behind, i.e. c = s * z + o with s = max / (S1 - near), o = -s * S1 (and likewise far).
+        // With the focus at infinity the near ramp's limit is flat: c = -max for every finite z
+        // (computing it directly would give 0 * inf = NaN).
         k.inverseDepth = false;
-        const double nearScale = lens.maxCocPx / (lens.focusM - lens.nearLimitM);
-        k.nearScale = static_cast<float>(nearScale);
-        k.nearOffset = static_cast<float>(-nearScale * lens.focusM);
+        if (std::isinf(lens.focusM)) {
+            k.nearOffset = -k.maxCocPx;
+        } else {
+            const double nearScale = lens.maxCocPx / (lens.focusM - lens.nearLimitM);
+            k.nearScale = static_cast<float>(nearScale);
+            k.nearOffset = static_cast<float>(-nearScale * lens.focusM);
+        }
         if (!std::isinf(lens.farLimitM)) {
             const double farScale = lens.maxCocPx / (lens.farLimitM - lens.focusM);
             k.farScale = static_cast<float>(farScale);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -64,7 +65,8 @@ std::vector<SettingIssue> validate(LensSettings& lens, bool clamp)
             if (clamp)
                 lens.nearLimitM = std::isnan(lens.nearLimitM) ? 0.0 : std::clamp(lens.nearLimitM, 0.0, lens.focusM * 0.99);
         }
-        if (!(lens.farLimitM > lens.focusM)) {
+        // +inf is the closed end of (focus, +inf], so it stays allowed when the focus is at infinity.
+        if (!(lens.farLimitM > lens.focusM || lens.farLimitM == std::numeric_limits<double>::infinity())) {
             issues.push_back({"--far", fmt::format("--far {} m must be farther than focus {} m", lens.farLimitM, lens.focusM)});
             if (clamp)
                 lens.farLimitM = lens.focusM * 1.01;

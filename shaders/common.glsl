@@ -6,9 +6,11 @@ vec3 srgbToLinear(vec3 c)
     return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
 }
 
-// Replaces NaN and +-Inf with 0 and keeps values inside what the render target can hold.
+// Keeps colour finite and inside what the render target holds: NaN becomes 0, negatives 0, and
+// +Inf or anything above `largest` becomes `largest` (a blown-out highlight stays bright).
+// filter/ColorSpace.cpp's sanitizeLinear() does the same on the CPU: keep the two in step.
 vec3 sanitizeColor(vec3 c, float largest)
 {
-    bvec3 bad = bvec3(isnan(c.r) || isinf(c.r), isnan(c.g) || isinf(c.g), isnan(c.b) || isinf(c.b));
-    return clamp(mix(c, vec3(0.0), bad), vec3(0.0), vec3(largest));
+    const bvec3 nan = bvec3(isnan(c.r), isnan(c.g), isnan(c.b));
+    return clamp(mix(c, vec3(0.0), nan), vec3(0.0), vec3(largest));
 }

@@ -40,7 +40,9 @@ int tapStride(float diameter)
 
 void main()
 {
-    const vec4 center = textureLod(uSource, vUv, 0.0);
+    // The centre texel exactly: a filtered fetch at the pixel centre is not exact on every
+    // driver (llvmpipe mixes in a neighbour by one half-float step), which would move in-focus pixels.
+    const vec4 center = texelFetch(uSource, ivec2(gl_FragCoord.xy), 0);
     const float diameter = abs(center.a);
     if (diameter < 0.5) { // a CoC below half a pixel is in focus: keep the pixel as it is
         outColor = center;
@@ -63,6 +65,9 @@ void main()
         sum += tap * weight;
         totalWeight += weight;
     }
-    // Every tap rejected (sharp foreground all around): keep the centre rather than divide by 0.
-    outColor = totalWeight > 1e-6 ? sum / totalWeight : center;
+    // When the bleeding rule leaves less than one tap's worth of weight (sharp foreground all
+    // around), the centre fills the rest: the result moves continuously from the normalised
+    // average (totalWeight >= 1, the usual case, unchanged) to the centre itself (totalWeight 0),
+    // instead of jumping from the foreground's average to the centre, and never divides by 0.
+    outColor = (sum + center * max(1.0 - totalWeight, 0.0)) / max(totalWeight, 1.0);
 }

@@ -1,6 +1,9 @@
 // CoC pass: uploads the lens coefficients and draws coc.frag.
 #include "filter/passes/CocPass.hpp"
 
+#include <limits>
+
+#include "filter/passes/HexBlurPass.hpp"
 #include "filter/passes/Pass.hpp"
 
 namespace defocus {
@@ -12,6 +15,20 @@ CocPass::CocPass()
 {
 }
 
+namespace {
+
+// The largest colour a target keeps. Half float: its maximum. Full float: small enough that
+// hex_blur.frag's sum of up to kMaxSamples taps cannot overflow to +Inf before it is divided.
+constexpr float kLargestHalf = 65504.0f;
+constexpr float kLargestFloat = std::numeric_limits<float>::max() / HexBlurPass::kMaxSamples;
+
+} // namespace
+
+float CocPass::largestColor(bool halfTarget)
+{
+    return halfTarget ? kLargestHalf : kLargestFloat;
+}
+
 void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
                   const gl::Framebuffer& target)
 {
@@ -19,7 +36,7 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocC
                      k.focusM,
                      k.maxCocPx,
                      k.inverseDepth ? 1 : 0,
-                     halfTarget ? 65504.0f : 3.0e38f};
+                     largestColor(halfTarget)};
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();

@@ -11,6 +11,8 @@ class CocPass {
 public:
     static constexpr const char* kName = "coc";
     CocPass();
+    /// The largest colour the CoC pass keeps for a half-float or a full-float target.
+    static float largestColor(bool halfTarget);
     /// `color`: sRGB8 or float RGB; `depth`: R32F metres with no holes; `halfTarget` keeps HDR
     /// colour below the half-float maximum.
     void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
