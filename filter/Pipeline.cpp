@@ -8,6 +8,7 @@
 
 #include <epoxy/gl.h>
 
+#include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
 #include "filter/Views.hpp"
@@ -15,6 +16,7 @@
 #include "filter/gl/Objects.hpp"
 #include "filter/passes/CocPass.hpp"
 #include "filter/passes/CompositePass.hpp"
+#include "filter/passes/CopyPass.hpp"
 #include "filter/passes/HexBlurPass.hpp"
 #include "filter/passes/ViewPass.hpp"
 
@@ -58,10 +60,12 @@ struct Pipeline::Impl {
     CocPass cocPass;
     HexBlurPass hexBlurPass;
     CompositePass compositePass;
+    CopyPass copyPass;
     ViewPass viewPass;
+    TileList blurTiles, copyTiles;
     gl::GpuTimer timer;
 
-    gl::Texture color;
+    gl::Texture colorTexture;
     gl::Texture depth;
     Target coc, horizontal, diagonalA, diagonalB, outSrgb, outLinear;
 
@@ -70,6 +74,19 @@ struct Pipeline::Impl {
     float maxCocPx = 0.0f;
     FrameTimings timings;
     Clock::time_point frameStart;
+
+    // The last frame, kept until its passes have run (they are skipped when all is in focus
+    // and the composite is all that is read).
+    cv::Mat color;
+    CocCoefficients coefficients;
+    QualitySettings quality;
+    SceneAnalysis analysis;
+    FramePlan plan;
+    bool rendered = false;
+    std::size_t frameIndex = 0;
+    std::size_t gpuFrameIndex = 0; ///< frame whose GPU scopes are pending in the timer
+
+    void render();
 
     explicit Impl(bool timers) : timer(timers) {}
 
@@ -94,6 +111,20 @@ Pipeline::Pipeline(bool timers)
     glEnable(GL_FRAMEBUFFER_SRGB);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
+
+    // Warm-up: drivers compile shaders on first draw (llvmpipe JITs them) and llvmpipe reports
+    // garbage for the first timer queries of a context; pay both here, not on a user's frame 0.
+    cv::Mat color(32, 32, CV_8UC3, cv::Scalar::all(128)), depth(32, 32, CV_32F, cv::Scalar(4.0f));
+    depth(cv::Rect(0, 0, 16, 16)).setTo(1.0f);
+    LensSettings lens;
+    lens.focusM = 1.0;
+    QualitySettings quality;
+    for (const View view : {View::Composite, View::Input}) {
+        run({color, depth, 0.0, 0, "warm-up"}, lens, quality, view, Encoding::Srgb8);
+        run({color, depth, 0.0, 0, "warm-up"}, lens, quality, view, Encoding::Linear32F);
+    }
+    drainGpuTimes();
+    impl_->timings = {};
 }
 
 Pipeline::~Pipeline() = default;
@@ -113,38 +144,61 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     p.timings.depthPrepMs = msSince(start);
 
     start = Clock::now();
-    const bool srgbInput = frame.color.type() == CV_8UC3;
-    ensureTexture(p.color, srgbInput ? GL_SRGB8 : GL_RGB32F, p.size, "input colour");
-    CV_Assert(frame.color.isContinuous() && p.prepared.metres.isContinuous());
-    p.color.upload(GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT, frame.color.data);
-    ensureTexture(p.depth, GL_R32F, p.size, "filled depth");
-    p.depth.upload(GL_RED, GL_FLOAT, p.prepared.metres.data);
-    p.timings.uploadMs = msSince(start);
+    p.color = frame.color;
+    p.quality = quality;
+    p.coefficients = cocCoefficients(lens, p.size.width);
+    p.maxCocPx = p.coefficients.maxCocPx;
+    p.frameIndex = frame.index;
+    p.analysis = analyseScene(p.prepared.metres, frame.color, p.coefficients, p.prepared.invalidFraction);
+    p.plan = makePlan(p.analysis);
+    p.timings.analysisMs = msSince(start);
+    p.rendered = false;
+    if (!(quality.adaptive && p.plan.allInFocus))
+        p.render();
+}
+
+void Pipeline::Impl::render()
+{
+    auto start = Clock::now();
+    const bool srgbInput = color.type() == CV_8UC3;
+    ensureTexture(depth, GL_R32F, size, "filled depth");
+    ensureTexture(colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, size, "input colour");
+    CV_Assert(color.isContinuous() && prepared.metres.isContinuous());
+    colorTexture.upload(GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT, color.data);
+    depth.upload(GL_RED, GL_FLOAT, prepared.metres.data);
+    timings.uploadMs = msSince(start);
 
     start = Clock::now();
     const bool half = quality.targetFormat == TargetFormat::Rgba16F;
     const GLenum format = half ? GL_RGBA16F : GL_RGBA32F;
-    p.coc.ensure(format, p.size, "coc");
-    p.horizontal.ensure(format, p.size, "horizontal");
-    p.diagonalA.ensure(format, p.size, "diagonal A");
-    p.diagonalB.ensure(format, p.size, "diagonal B");
+    coc.ensure(format, size, "coc");
+    horizontal.ensure(format, size, "horizontal");
+    diagonalA.ensure(format, size, "diagonal A");
+    diagonalB.ensure(format, size, "diagonal B");
 
-    const CocCoefficients k = cocCoefficients(lens, p.size.width);
-    p.maxCocPx = k.maxCocPx;
-    glBindVertexArray(p.vao.id());
-    p.timer.begin(CocPass::kName);
-    p.cocPass.run(p.color, p.depth, k, half, p.coc.framebuffer);
-    p.timer.end();
-    p.timer.begin("horizontal");
-    p.hexBlurPass.run(p.coc.texture, p.depth, 0.0f, quality.samples, p.horizontal.framebuffer);
-    p.timer.end();
-    p.timer.begin("diagonal-a");
-    p.hexBlurPass.run(p.horizontal.texture, p.depth, 120.0f, quality.samples, p.diagonalA.framebuffer);
-    p.timer.end();
-    p.timer.begin("diagonal-b");
-    p.hexBlurPass.run(p.horizontal.texture, p.depth, -120.0f, quality.samples, p.diagonalB.framebuffer);
-    p.timer.end();
-    p.timings.renderMs = msSince(start);
+    // Tiles in focus are copied, not blurred, when the plan says some are.
+    const bool useTiles = quality.adaptive && !plan.copyTiles.empty();
+    if (useTiles) {
+        blurTiles.set(plan.blurTiles, size, SceneAnalysis::kTileSize);
+        copyTiles.set(plan.copyTiles, size, SceneAnalysis::kTileSize);
+    }
+    const auto blur = [&](const char* name, const gl::Texture& source, float angle, const Target& target) {
+        timer.begin(name);
+        hexBlurPass.run(source, depth, angle, quality.samples, target.framebuffer, useTiles ? &blurTiles : nullptr);
+        if (useTiles)
+            copyPass.run(source, copyTiles, target.framebuffer);
+        timer.end();
+    };
+
+    glBindVertexArray(vao.id());
+    timer.begin(CocPass::kName);
+    cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer);
+    timer.end();
+    blur("horizontal", coc.texture, 0.0f, horizontal);
+    blur("diagonal-a", horizontal.texture, 120.0f, diagonalA);
+    blur("diagonal-b", horizontal.texture, -120.0f, diagonalB);
+    timings.renderMs = msSince(start);
+    rendered = true;
 }
 
 cv::Mat Pipeline::read(View view, Encoding encoding)
@@ -152,6 +206,24 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
     Impl& p = *impl_;
     CV_Assert(!p.size.empty());
     const auto start = Clock::now();
+    if (view == View::Composite && !p.rendered) {
+        // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
+        // CoC pass's clean-up (no NaN, no negatives, within the target's range).
+        const bool srgbInput = p.color.type() == CV_8UC3;
+        const cv::Mat linear = srgbInput ? cv::Mat()
+                                         : sanitizeLinear(p.color, CocPass::largestColor(
+                                                                        p.quality.targetFormat == TargetFormat::Rgba16F));
+        cv::Mat image;
+        if (encoding == Encoding::Srgb8)
+            image = srgbInput ? p.color.clone() : encodeSrgb(linear);
+        else
+            image = srgbInput ? decodeSrgb(p.color) : linear;
+        p.timings.readbackMs = msSince(start);
+        p.timings.totalMs = msSince(p.frameStart);
+        return image;
+    }
+    if (!p.rendered)
+        p.render();
     Target& out = encoding == Encoding::Srgb8 ? p.outSrgb : p.outLinear;
     out.ensure(encoding == Encoding::Srgb8 ? GL_SRGB8_ALPHA8 : GL_RGBA32F, p.size,
                encoding == Encoding::Srgb8 ? "output sRGB" : "output linear");
@@ -185,8 +257,11 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
                  encoding == Encoding::Srgb8 ? GL_UNSIGNED_BYTE : GL_FLOAT, image.data);
     p.timings.readbackMs = msSince(start);
 
-    for (auto& [name, ms] : p.timer.collect())
+    p.timings.gpu.clear();
+    for (auto& [name, ms] : p.timer.swap())
         p.timings.gpu.push_back({name, ms});
+    p.timings.gpuFrame = p.gpuFrameIndex;
+    p.gpuFrameIndex = p.frameIndex;
     p.timings.totalMs = msSince(p.frameStart);
 
     if (view == View::Depth)
@@ -205,6 +280,8 @@ cv::Mat Pipeline::run(const Frame& frame, const LensSettings& lens, const Qualit
 
 cv::Mat Pipeline::readTarget(View view) const
 {
+    if (!impl_->rendered)
+        impl_->render();
     const Target& target = impl_->target(view);
     cv::Mat image(impl_->size, CV_32FC4);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, target.framebuffer.id());
@@ -226,6 +303,24 @@ double Pipeline::invalidDepthFraction() const
 const FrameTimings& Pipeline::timings() const
 {
     return impl_->timings;
+}
+
+std::vector<PassTime> Pipeline::drainGpuTimes()
+{
+    std::vector<PassTime> times;
+    for (auto& [name, ms] : impl_->timer.drain())
+        times.push_back({name, ms});
+    return times;
+}
+
+const SceneAnalysis& Pipeline::analysis() const
+{
+    return impl_->analysis;
+}
+
+const FramePlan& Pipeline::plan() const
+{
+    return impl_->plan;
 }
 
 } // namespace defocus

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "filter/Frame.hpp"
+#include "filter/SceneAnalysis.hpp"
 #include "filter/Settings.hpp"
 
 namespace defocus {
@@ -29,11 +30,15 @@ struct PassTime {
 /// queries (empty when the driver has none).
 struct FrameTimings {
     double depthPrepMs = 0.0; ///< resize + hole filling on the CPU
+    double analysisMs = 0.0;  ///< scene analysis + plan on the CPU
     double uploadMs = 0.0;    ///< colour + depth to textures
     double renderMs = 0.0;    ///< submitting the passes
     double readbackMs = 0.0;  ///< output pass + glReadPixels (waits for the GPU)
     double totalMs = 0.0;     ///< process() + read(), wall clock
+    /// GPU time per pass of frame `gpuFrame`: timer queries are read one frame late so that
+    /// they never stall; empty on the first frame and when the driver has no timers.
     std::vector<PassTime> gpu;
+    std::size_t gpuFrame = 0;
 };
 
 class Pipeline {
@@ -63,6 +68,12 @@ public:
     double invalidDepthFraction() const;
     /// Timings of the last process() + read().
     const FrameTimings& timings() const;
+    /// GPU times of the last frame, waiting for them (call once at the end of a stream).
+    std::vector<PassTime> drainGpuTimes();
+
+    /// What the last frame called for, and what ran.
+    const SceneAnalysis& analysis() const;
+    const FramePlan& plan() const;
 
 private:
     struct Impl;

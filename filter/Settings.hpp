@@ -46,6 +46,9 @@ struct QualitySettings {
     /// Taps per directional blur pass, [2, 64].
     int samples = 16;
     TargetFormat targetFormat = TargetFormat::Rgba16F;
+    /// Follow the per-frame plan: skip every pass when the frame is all in focus and blur only
+    /// the tiles that need it. false runs every pass on every pixel (for comparisons).
+    bool adaptive = true;
 };
 
 /// What the pipeline writes out. The first five are the McIntosh lab's modes 1-5.

@@ -7,11 +7,13 @@
 #include <csignal>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <string>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
@@ -54,6 +56,8 @@ struct Options {
     std::size_t contactFrame = 0;
     std::optional<std::size_t> frames;
     std::optional<double> fps;
+    std::string timings;
+    bool explain = false;
     bool info = false;
     bool quiet = false;
     bool verbose = false;
@@ -83,6 +87,66 @@ std::string summarise(std::size_t in, std::size_t out, const std::map<std::strin
                        in, out, totalMs / n, passes.empty() ? "n/a" : passes, uploadMs / n, readbackMs / n);
 }
 
+/// Per-frame timings for --timings, and their p50/p95/max summary.
+class TimingLog {
+public:
+    void frame(const FrameTimings& t, std::size_t index)
+    {
+        frames_.push_back({{"index", index},
+                           {"total_ms", t.totalMs},
+                           {"depth_prep_ms", t.depthPrepMs},
+                           {"analysis_ms", t.analysisMs},
+                           {"upload_ms", t.uploadMs},
+                           {"render_ms", t.renderMs},
+                           {"readback_ms", t.readbackMs},
+                           {"gpu_ms", nlohmann::json::object()}});
+        if (!t.gpu.empty())
+            gpu(t.gpu, t.gpuFrame);
+    }
+    /// GPU times arrive one frame late; they go to the frame they measured.
+    void gpu(const std::vector<PassTime>& passes, std::size_t index)
+    {
+        for (auto& f : frames_)
+            if (f["index"] == index)
+                for (const auto& pass : passes)
+                    f["gpu_ms"][pass.name] = pass.ms;
+    }
+    void write(const std::string& file, const std::string& renderer, cv::Size size) const
+    {
+        nlohmann::json summary;
+        const auto stats = [](std::vector<double> v) {
+            std::sort(v.begin(), v.end());
+            const auto at = [&](double q) { return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)]; };
+            return nlohmann::json{{"p50", at(0.5)}, {"p95", at(0.95)}, {"max", v.back()}, {"frames", v.size()}};
+        };
+        for (const char* key : {"total_ms", "depth_prep_ms", "analysis_ms", "upload_ms", "render_ms", "readback_ms"}) {
+            std::vector<double> v;
+            for (const auto& f : frames_)
+                v.push_back(f[key].get<double>());
+            if (!v.empty())
+                summary[key] = stats(v);
+        }
+        std::map<std::string, std::vector<double>> passes;
+        for (const auto& f : frames_)
+            for (const auto& [name, ms] : f["gpu_ms"].items())
+                passes[name].push_back(ms.get<double>());
+        for (const auto& [name, v] : passes)
+            summary["gpu_ms"][name] = stats(v);
+        const nlohmann::json doc{{"renderer", renderer},
+                                 {"width", size.width},
+                                 {"height", size.height},
+                                 {"summary", summary},
+                                 {"frames", frames_}};
+        std::ofstream out(file);
+        out << doc.dump(2) << "\n";
+        if (!out)
+            throw SinkError(fmt::format("cannot write timings '{}'", file));
+    }
+
+private:
+    std::vector<nlohmann::json> frames_;
+};
+
 int run(const Options& options)
 {
     SourceOptions sourceOptions{options.input, std::nullopt, options.depthScale};
@@ -109,6 +173,8 @@ int run(const Options& options)
     Progress progress(total, !options.quiet);
 
     LensSettings lens = options.lens;
+    TimingLog timingLog;
+    cv::Size frameSize;
     std::map<std::string, double> passMs;
     double totalMs = 0, uploadMs = 0, readbackMs = 0;
     std::size_t framesIn = 0, timed = 0;
@@ -140,16 +206,18 @@ int run(const Options& options)
                 pipeline.run(*frame, lens, options.quality, view, encoding); // keep timings of a plain frame
             }
             sink->write(image);
+            frameSize = image.size();
+            if (options.explain)
+                std::printf("frame %zu: %s\n", frame->index, pipeline.plan().explain(pipeline.analysis()).c_str());
 
             const FrameTimings& t = pipeline.timings();
-            if (framesIn > 1 || total == std::optional<std::size_t>(1)) { // frame 1 pays for shader warm-up
-                for (const auto& pass : t.gpu)
-                    passMs[pass.name] += pass.ms;
-                totalMs += t.totalMs;
-                uploadMs += t.uploadMs;
-                readbackMs += t.readbackMs;
-                ++timed;
-            }
+            timingLog.frame(t, frame->index);
+            for (const auto& pass : t.gpu)
+                passMs[pass.name] += pass.ms;
+            totalMs += t.totalMs;
+            uploadMs += t.uploadMs;
+            readbackMs += t.readbackMs;
+            ++timed;
             progress.update(framesIn);
         }
     } catch (const std::exception& error) {
@@ -159,6 +227,13 @@ int run(const Options& options)
     }
     sink->finish();
     progress.finish();
+    const auto lastGpu = pipeline.drainGpuTimes();
+    if (framesIn > 0)
+        timingLog.gpu(lastGpu, framesIn - 1);
+    for (const auto& pass : lastGpu)
+        passMs[pass.name] += pass.ms;
+    if (!options.timings.empty())
+        timingLog.write(options.timings, context.info().glRenderer, frameSize);
     if (gStop) {
         spdlog::warn("stopped by signal after {} frames; {} is finalised", framesIn, options.output);
         exitCode = kInterrupted;
@@ -222,6 +297,10 @@ int main(int argc, char** argv)
     app.add_option("--contact-frame", o.contactFrame, "Frame index for --contact-sheet")->capture_default_str();
     app.add_option("--frames", o.frames, "Stop after this many frames")->check(CLI::PositiveNumber);
     app.add_option("--fps", o.fps, "Frame rate of a video output, Hz [default: the input's]")->check(CLI::PositiveNumber);
+    app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
+    app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
+    bool alwaysOn = false;
+    app.add_flag("--always-on", alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
     app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
     app.add_flag("-q,--quiet", o.quiet, "Only the summary line and errors");
     app.add_flag("-v,--verbose", o.verbose, "Debug logging");
@@ -241,6 +320,7 @@ int main(int argc, char** argv)
             spdlog::error("INPUT and -o OUTPUT are required (see --help)");
             return kUsage;
         }
+        o.quality.adaptive = !alwaysOn;
         o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
         o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
         if (o.focus == "inf" || o.focus == "infinity") {

@@ -1,19 +1,34 @@
-// GL_TIME_ELAPSED query pool.
+// Double-buffered GL_TIME_ELAPSED query pools.
 #include "filter/gl/GpuTimer.hpp"
 
 namespace defocus::gl {
+
+GpuTimer::GpuTimer(bool enabled) : enabled_(enabled)
+{
+    if (!enabled_)
+        return;
+    // Some drivers (llvmpipe) report garbage for the very first query of a context: spend it here.
+    GLuint id = 0;
+    glCreateQueries(GL_TIME_ELAPSED, 1, &id);
+    glBeginQuery(GL_TIME_ELAPSED, id);
+    glEndQuery(GL_TIME_ELAPSED);
+    GLuint64 unused = 0;
+    glGetQueryObjectui64v(id, GL_QUERY_RESULT, &unused);
+    glDeleteQueries(1, &id);
+}
 
 void GpuTimer::begin(const std::string& name)
 {
     if (!enabled_)
         return;
-    if (used_ == scopes_.size()) {
+    Set& set = sets_[current_];
+    if (set.used == set.scopes.size()) {
         GLuint id = 0;
         glCreateQueries(GL_TIME_ELAPSED, 1, &id);
-        scopes_.push_back({name, Handle<deleteQuery>(id)});
+        set.scopes.push_back({name, Handle<deleteQuery>(id)});
     }
-    scopes_[used_].name = name;
-    glBeginQuery(GL_TIME_ELAPSED, scopes_[used_].query.id());
+    set.scopes[set.used].name = name;
+    glBeginQuery(GL_TIME_ELAPSED, set.scopes[set.used].query.id());
 }
 
 void GpuTimer::end()
@@ -21,19 +36,35 @@ void GpuTimer::end()
     if (!enabled_)
         return;
     glEndQuery(GL_TIME_ELAPSED);
-    ++used_;
+    ++sets_[current_].used;
 }
 
-std::vector<std::pair<std::string, double>> GpuTimer::collect()
+GpuTimer::Results GpuTimer::read(Set& set)
 {
-    std::vector<std::pair<std::string, double>> results;
-    for (std::size_t i = 0; i < used_; ++i) {
+    Results results;
+    for (std::size_t i = 0; i < set.used; ++i) {
         GLuint64 ns = 0;
-        glGetQueryObjectui64v(scopes_[i].query.id(), GL_QUERY_RESULT, &ns);
-        results.emplace_back(scopes_[i].name, static_cast<double>(ns) * 1e-6);
+        glGetQueryObjectui64v(set.scopes[i].query.id(), GL_QUERY_RESULT, &ns);
+        // Passes timed in several scopes (blur tiles + copy tiles) add up under one name.
+        if (!results.empty() && results.back().first == set.scopes[i].name)
+            results.back().second += static_cast<double>(ns) * 1e-6;
+        else
+            results.emplace_back(set.scopes[i].name, static_cast<double>(ns) * 1e-6);
     }
-    used_ = 0;
+    set.used = 0;
     return results;
+}
+
+GpuTimer::Results GpuTimer::swap()
+{
+    current_ = 1 - current_;
+    return read(sets_[current_]);
+}
+
+GpuTimer::Results GpuTimer::drain()
+{
+    // After swap() the frame just ended is in the other set.
+    return read(sets_[1 - current_]);
 }
 
 } // namespace defocus::gl

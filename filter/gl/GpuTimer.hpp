@@ -1,8 +1,10 @@
-// GPU time per pass from GL_TIME_ELAPSED queries. One query object per named scope, reused
-// every frame; results are collected after the frame's readback, when the GPU is done anyway.
+// GPU time per pass from GL_TIME_ELAPSED queries, double-buffered: the results read after a
+// frame are those of the frame before, which the GPU has long finished, so reading them never
+// stalls the pipeline.
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "filter/gl/Objects.hpp"
@@ -11,24 +13,35 @@ namespace defocus::gl {
 
 class GpuTimer {
 public:
+    using Results = std::vector<std::pair<std::string, double>>; ///< (scope name, milliseconds)
+
     /// `enabled` false makes every call a no-op (drivers without timer queries).
-    explicit GpuTimer(bool enabled = true) : enabled_(enabled) {}
+    explicit GpuTimer(bool enabled = true);
 
     /// Starts timing the scope `name` (scopes do not nest).
     void begin(const std::string& name);
     void end();
-    /// Collects the results of the scopes timed since the last call: (name, milliseconds).
-    /// Waits for the GPU if it has not finished.
-    std::vector<std::pair<std::string, double>> collect();
+    /// Ends the current frame's set of scopes and returns the previous frame's results
+    /// (empty after the first frame).
+    Results swap();
+    /// Returns the results of the frame ended by the last swap(), waiting for the GPU: for the
+    /// end of a stream.
+    Results drain();
 
 private:
     struct Scope {
         std::string name;
         Handle<deleteQuery> query;
     };
+    struct Set {
+        std::vector<Scope> scopes; ///< pool, reused
+        std::size_t used = 0;      ///< scopes begun in this set's frame
+    };
+    Results read(Set& set);
+
     bool enabled_;
-    std::vector<Scope> scopes_;   ///< pool, reused frame after frame
-    std::size_t used_ = 0;        ///< scopes begun since the last collect()
+    Set sets_[2];
+    int current_ = 0;
 };
 
 } // namespace defocus::gl

@@ -13,6 +13,7 @@ namespace defocus {
 
 HexBlurPass::HexBlurPass()
     : program_("fullscreen.vert", "hex_blur.frag", "hex_blur", {fmt::format("MAX_SAMPLES {}", kMaxSamples)}),
+      tileProgram_("tiles.vert", "hex_blur.frag", "hex_blur tiles", {fmt::format("MAX_SAMPLES {}", kMaxSamples)}),
       uniforms_(sizeof(Uniforms), "hex blur params"),
       linear_(GL_LINEAR, "hex blur linear"),
       nearest_(GL_NEAREST, "hex blur nearest")
@@ -36,7 +37,7 @@ std::vector<glm::vec2> HexBlurPass::offsets(float angleDegrees, int samples, int
 }
 
 void HexBlurPass::run(const gl::Texture& source, const gl::Texture& depth, float angleDegrees, int samples,
-                      const gl::Framebuffer& target)
+                      const gl::Framebuffer& target, const TileList* tiles)
 {
     Uniforms u{};
     const auto taps = offsets(angleDegrees, samples, target.width(), target.height());
@@ -52,10 +53,15 @@ void HexBlurPass::run(const gl::Texture& source, const gl::Texture& depth, float
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();
-    program_.use();
     bindTexture(0, source.id(), linear_.id());
     bindTexture(1, depth.id(), nearest_.id());
-    drawFullscreenTriangle();
+    if (tiles) {
+        tileProgram_.use();
+        tiles->draw();
+    } else {
+        program_.use();
+        drawFullscreenTriangle();
+    }
 }
 
 } // namespace defocus

@@ -7,6 +7,7 @@
 
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
+#include "filter/passes/TileList.hpp"
 
 namespace defocus {
 
@@ -22,9 +23,10 @@ public:
 
     HexBlurPass();
     /// Blurs `source` (rgb + signed CoC) along `angleDegrees` (counter-clockwise on screen, 0 =
-    /// horizontal) with `samples` taps; `depth` is the filled depth in metres.
+    /// horizontal) with `samples` taps; `depth` is the filled depth in metres. With `tiles`,
+    /// only those tiles are drawn; otherwise the whole target.
     void run(const gl::Texture& source, const gl::Texture& depth, float angleDegrees, int samples,
-             const gl::Framebuffer& target);
+             const gl::Framebuffer& target, const TileList* tiles = nullptr);
 
     /// Texture-space tap offsets per pixel of CoC diameter: `samples` points evenly spaced from
     /// -d/2 to +d/2 along the angle, divided by the image size so that pixels stay square.
@@ -41,6 +43,7 @@ private:
         float maxTapSpacing;
     };
     gl::Program program_;
+    gl::Program tileProgram_; ///< the same shader on tiles.vert
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
     gl::Sampler nearest_;

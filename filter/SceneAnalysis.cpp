@@ -1,0 +1,108 @@
+// Scene analysis on the CPU, where the filled depth already is: the only place the "all in
+// focus" decision can be made before any upload or pass, which is what makes such a frame cheap.
+#include "filter/SceneAnalysis.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace defocus {
+
+float SceneAnalysis::maxAbsCoc() const
+{
+    return std::max(std::abs(minCoc), std::abs(maxCoc));
+}
+
+bool SceneAnalysis::tileNeedsBlur(int x, int y) const
+{
+    return std::max(std::abs(tileMinCoc.at<float>(y, x)), std::abs(tileMaxCoc.at<float>(y, x))) >= 0.5f;
+}
+
+SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k,
+                           double invalidDepthFraction)
+{
+    CV_Assert(filledDepth.type() == CV_32FC1 && filledDepth.size() == color.size());
+    SceneAnalysis a;
+    constexpr int T = SceneAnalysis::kTileSize;
+    a.tiles = {(filledDepth.cols + T - 1) / T, (filledDepth.rows + T - 1) / T};
+    a.invalidDepthFraction = invalidDepthFraction;
+
+    // CoC is monotonic in depth, so the tile's CoC range is the CoC of its depth range; only
+    // the histogram needs a CoC per pixel.
+    cv::Mat tileMinZ(a.tiles, CV_32F, cv::Scalar(std::numeric_limits<float>::max()));
+    cv::Mat tileMaxZ(a.tiles, CV_32F, cv::Scalar(std::numeric_limits<float>::lowest()));
+    for (int y = 0; y < filledDepth.rows; ++y) {
+        const float* z = filledDepth.ptr<float>(y);
+        float* lo = tileMinZ.ptr<float>(y / T);
+        float* hi = tileMaxZ.ptr<float>(y / T);
+        for (int x = 0; x < filledDepth.cols; ++x) {
+            lo[x / T] = std::min(lo[x / T], z[x]);
+            hi[x / T] = std::max(hi[x / T], z[x]);
+            const float c = std::abs(cocPixels(k, z[x]));
+            const auto bin = std::upper_bound(SceneAnalysis::kHistogramEdges.begin(),
+                                              SceneAnalysis::kHistogramEdges.end(), c) -
+                             SceneAnalysis::kHistogramEdges.begin();
+            ++a.histogram[static_cast<std::size_t>(bin)];
+        }
+    }
+    a.tileMinCoc.create(a.tiles, CV_32F);
+    a.tileMaxCoc.create(a.tiles, CV_32F);
+    a.minCoc = std::numeric_limits<float>::max();
+    a.maxCoc = std::numeric_limits<float>::lowest();
+    for (int ty = 0; ty < a.tiles.height; ++ty)
+        for (int tx = 0; tx < a.tiles.width; ++tx) {
+            const float lo = cocPixels(k, tileMinZ.at<float>(ty, tx));
+            const float hi = cocPixels(k, tileMaxZ.at<float>(ty, tx));
+            a.tileMinCoc.at<float>(ty, tx) = std::min(lo, hi);
+            a.tileMaxCoc.at<float>(ty, tx) = std::max(lo, hi);
+            a.minCoc = std::min(a.minCoc, std::min(lo, hi));
+            a.maxCoc = std::max(a.maxCoc, std::max(lo, hi));
+        }
+    a.foreground = a.minCoc <= -0.5f;
+
+    cv::Mat bright;
+    if (color.depth() == CV_8U) {
+        cv::Mat channelMax;
+        cv::reduce(color.reshape(1, static_cast<int>(color.total())), channelMax, 1, cv::REDUCE_MAX);
+        bright = channelMax >= 250;
+    } else {
+        cv::Mat luminance;
+        cv::transform(color, luminance, cv::Matx13f(0.0722f, 0.7152f, 0.2126f)); // BGR Rec.709
+        bright = luminance > 1.0f;
+    }
+    a.highlightFraction = static_cast<double>(cv::countNonZero(bright)) / static_cast<double>(color.total());
+    return a;
+}
+
+FramePlan makePlan(const SceneAnalysis& analysis)
+{
+    FramePlan plan;
+    plan.allInFocus = analysis.maxAbsCoc() < 0.5f;
+    plan.holeFill = analysis.invalidDepthFraction > 0.0;
+    plan.highlights = analysis.highlightFraction > 0.0;
+    plan.foreground = analysis.foreground;
+    if (plan.allInFocus)
+        return plan;
+    for (int y = 0; y < analysis.tiles.height; ++y)
+        for (int x = 0; x < analysis.tiles.width; ++x)
+            (analysis.tileNeedsBlur(x, y) ? plan.blurTiles : plan.copyTiles).emplace_back(x, y);
+    return plan;
+}
+
+std::string FramePlan::explain(const SceneAnalysis& analysis) const
+{
+    const int total = analysis.tiles.area();
+    std::string text = allInFocus ? fmt::format("all in focus (max |CoC| {:.2f} px): input passed through, no pass ran",
+                                                analysis.maxAbsCoc())
+                                  : fmt::format("coc, blur x3 on {}/{} tiles (copy {}), composite; CoC {:+.1f}..{:+.1f} px",
+                                                blurTiles.size(), total, copyTiles.size(), analysis.minCoc,
+                                                analysis.maxCoc);
+    text += holeFill ? fmt::format("; hole fill on ({:.1f} % invalid)", 100.0 * analysis.invalidDepthFraction)
+                     : "; hole fill off (no holes)";
+    text += foreground ? "; foreground blur present" : "; no foreground blur";
+    text += highlights ? fmt::format("; highlights {:.2f} %", 100.0 * analysis.highlightFraction) : "; no highlights";
+    return text;
+}
+
+} // namespace defocus

@@ -1,0 +1,56 @@
+// What a frame calls for, measured before any GPU work: per-tile CoC range, a CoC histogram,
+// foreground blur, highlights and holes. The plan made from it decides which passes run where.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "filter/Lens.hpp"
+
+namespace defocus {
+
+struct SceneAnalysis {
+    static constexpr int kTileSize = 16; ///< pixels per tile side
+    /// Upper edges of the |CoC| histogram bins, pixels; the last bin takes the rest.
+    static constexpr std::array<float, 8> kHistogramEdges{0.5f, 1.f, 2.f, 4.f, 8.f, 16.f, 32.f, 64.f};
+
+    cv::Size tiles;            ///< tile grid size (ceil(width / 16) x ceil(height / 16))
+    cv::Mat tileMinCoc;        ///< CV_32FC1 per tile: smallest signed CoC (pixels)
+    cv::Mat tileMaxCoc;        ///< CV_32FC1 per tile: largest signed CoC (pixels)
+    float minCoc = 0.0f;       ///< whole frame, signed pixels
+    float maxCoc = 0.0f;
+    std::array<int, kHistogramEdges.size() + 1> histogram{}; ///< pixel counts per |CoC| bin
+    bool foreground = false;   ///< some pixel is blurred in front of the focus plane (CoC <= -0.5)
+    double highlightFraction = 0.0; ///< pixels above the highlight threshold
+    double invalidDepthFraction = 0.0;
+
+    /// Largest |CoC| of the frame.
+    float maxAbsCoc() const;
+    /// |CoC| of the tile at (x, y) reaches half a pixel somewhere.
+    bool tileNeedsBlur(int x, int y) const;
+};
+
+/// Analyses a frame from its filled depth (CV_32FC1 metres) and colour (8-bit: highlights are
+/// clipped pixels, >= 250 in any channel; float: luminance above 1).
+SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k,
+                           double invalidDepthFraction);
+
+/// Which passes run, and on which tiles.
+struct FramePlan {
+    bool allInFocus = false;          ///< max |CoC| < 0.5 px: output = input, no pass runs
+    std::vector<cv::Point> blurTiles; ///< tiles the blur passes process
+    std::vector<cv::Point> copyTiles; ///< tiles only copied (in focus)
+    bool holeFill = false;            ///< depth had holes to fill
+    bool highlights = false;          ///< the frame has highlights (no highlight pass yet: reported only)
+    bool foreground = false;          ///< the frame has near blur (no near-field pass yet: reported only)
+
+    /// One line for --explain, e.g. "blur 812/1200 tiles, copy 388; hole fill on (24.1 % invalid)".
+    std::string explain(const SceneAnalysis& analysis) const;
+};
+
+FramePlan makePlan(const SceneAnalysis& analysis);
+
+} // namespace defocus

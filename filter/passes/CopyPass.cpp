@@ -1,0 +1,18 @@
+// Copy pass: copy.frag on the given tiles.
+#include "filter/passes/CopyPass.hpp"
+
+#include "filter/passes/Pass.hpp"
+
+namespace defocus {
+
+CopyPass::CopyPass() : program_("tiles.vert", "copy.frag", kName), nearest_(GL_NEAREST, "copy nearest") {}
+
+void CopyPass::run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target)
+{
+    target.bindForDraw();
+    program_.use();
+    bindTexture(0, source.id(), nearest_.id());
+    tiles.draw();
+}
+
+} // namespace defocus

@@ -1,0 +1,21 @@
+// Copies a texture into a target on a set of tiles: in-focus tiles skip the blur. Shader: copy.frag.
+#pragma once
+
+#include "filter/gl/Objects.hpp"
+#include "filter/gl/Program.hpp"
+#include "filter/passes/TileList.hpp"
+
+namespace defocus {
+
+class CopyPass {
+public:
+    static constexpr const char* kName = "copy";
+    CopyPass();
+    void run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target);
+
+private:
+    gl::Program program_;
+    gl::Sampler nearest_;
+};
+
+} // namespace defocus
