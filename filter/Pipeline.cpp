@@ -18,6 +18,7 @@
 #include "filter/passes/CompositePass.hpp"
 #include "filter/passes/CopyPass.hpp"
 #include "filter/passes/HexBlurPass.hpp"
+#include "filter/passes/NearBlurPass.hpp"
 #include "filter/passes/ViewPass.hpp"
 
 namespace defocus {
@@ -61,13 +62,16 @@ struct Pipeline::Impl {
     HexBlurPass hexBlurPass;
     CompositePass compositePass;
     CopyPass copyPass;
+    NearBlurPass nearBlurPass;
     ViewPass viewPass;
-    TileList blurTiles, copyTiles;
+    TileList blurTiles, copyTiles, nearTiles;
     gl::GpuTimer timer;
 
     gl::Texture colorTexture;
     gl::Texture depth;
     Target coc, horizontal, diagonalA, diagonalB, outSrgb, outLinear;
+    Target nearHorizontal, nearA, nearB; ///< the foreground layer's blurs
+    gl::Texture nearDiameter;            ///< per tile, R32F
 
     cv::Size size;
     PreparedDepth prepared;
@@ -150,7 +154,7 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     p.maxCocPx = p.coefficients.maxCocPx;
     p.frameIndex = frame.index;
     p.analysis = analyseScene(p.prepared.metres, frame.color, p.coefficients, p.prepared.invalidFraction);
-    p.plan = makePlan(p.analysis);
+    p.plan = makePlan(p.analysis, quality.nearField);
     p.timings.analysisMs = msSince(start);
     p.rendered = false;
     if (!(quality.adaptive && p.plan.allInFocus))
@@ -197,6 +201,23 @@ void Pipeline::Impl::render()
     blur("horizontal", coc.texture, 0.0f, horizontal);
     blur("diagonal-a", horizontal.texture, 120.0f, diagonalA);
     blur("diagonal-b", horizontal.texture, -120.0f, diagonalB);
+
+    if (plan.nearField) {
+        nearHorizontal.ensure(format, size, "near horizontal");
+        nearA.ensure(format, size, "near A");
+        nearB.ensure(format, size, "near B");
+        ensureTexture(nearDiameter, GL_R32F, analysis.tiles, "near diameter per tile");
+        CV_Assert(analysis.tileNearDiameter.isContinuous());
+        nearDiameter.upload(GL_RED, GL_FLOAT, analysis.tileNearDiameter.data);
+        nearTiles.set(plan.nearTiles, size, SceneAnalysis::kTileSize);
+        timer.begin("near-field");
+        nearBlurPass.run(coc.texture, nearDiameter, 0.0f, quality.samples, true, nearHorizontal.framebuffer, nearTiles);
+        nearBlurPass.run(nearHorizontal.texture, nearDiameter, 120.0f, quality.samples, false, nearA.framebuffer,
+                         nearTiles);
+        nearBlurPass.run(nearHorizontal.texture, nearDiameter, -120.0f, quality.samples, false, nearB.framebuffer,
+                         nearTiles);
+        timer.end();
+    }
     timings.renderMs = msSince(start);
     rendered = true;
 }
@@ -232,7 +253,9 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
     float low = 0.0f, high = 0.0f;
     if (view == View::Composite) {
         p.timer.begin(CompositePass::kName);
-        p.compositePass.run(p.diagonalA.texture, p.diagonalB.texture, out.framebuffer);
+        const bool near = p.plan.nearField;
+        p.compositePass.run(p.diagonalA.texture, p.diagonalB.texture, out.framebuffer,
+                            near ? &p.nearA.texture : nullptr, near ? &p.nearB.texture : nullptr);
     } else {
         p.timer.begin(ViewPass::kName);
         if (view == View::Depth) {

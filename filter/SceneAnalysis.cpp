@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
 
 namespace defocus {
 
@@ -61,6 +62,16 @@ SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, con
         }
     a.foreground = a.minCoc <= -0.5f;
 
+    // Foreground reach: a near pixel of diameter d blurs pixels up to d/2 away. One extra tile
+    // covers the linear filtering of this map between tile centres.
+    a.tileNearDiameter = cv::max(-a.tileMinCoc, 0.0f);
+    a.tileNearDiameter.setTo(0.0f, a.tileNearDiameter < 0.5f);
+    if (a.foreground) {
+        const int reach = static_cast<int>(std::ceil(-a.minCoc / 2.0f / static_cast<float>(T))) + 1;
+        cv::dilate(a.tileNearDiameter, a.tileNearDiameter,
+                   cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
+    }
+
     cv::Mat bright;
     if (color.depth() == CV_8U) {
         cv::Mat channelMax;
@@ -75,7 +86,7 @@ SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, con
     return a;
 }
 
-FramePlan makePlan(const SceneAnalysis& analysis)
+FramePlan makePlan(const SceneAnalysis& analysis, bool nearField)
 {
     FramePlan plan;
     plan.allInFocus = analysis.maxAbsCoc() < 0.5f;
@@ -84,9 +95,13 @@ FramePlan makePlan(const SceneAnalysis& analysis)
     plan.foreground = analysis.foreground;
     if (plan.allInFocus)
         return plan;
+    plan.nearField = nearField && analysis.foreground;
     for (int y = 0; y < analysis.tiles.height; ++y)
-        for (int x = 0; x < analysis.tiles.width; ++x)
+        for (int x = 0; x < analysis.tiles.width; ++x) {
             (analysis.tileNeedsBlur(x, y) ? plan.blurTiles : plan.copyTiles).emplace_back(x, y);
+            if (plan.nearField && analysis.tileNearDiameter.at<float>(y, x) >= 0.5f)
+                plan.nearTiles.emplace_back(x, y);
+        }
     return plan;
 }
 
@@ -100,7 +115,8 @@ std::string FramePlan::explain(const SceneAnalysis& analysis) const
                                                 analysis.maxCoc);
     text += holeFill ? fmt::format("; hole fill on ({:.1f} % invalid)", 100.0 * analysis.invalidDepthFraction)
                      : "; hole fill off (no holes)";
-    text += foreground ? "; foreground blur present" : "; no foreground blur";
+    text += nearField ? fmt::format("; near field on {} tiles", nearTiles.size())
+                      : foreground ? "; foreground blur, near field off" : "; no foreground blur, near field off";
     text += highlights ? fmt::format("; highlights {:.2f} %", 100.0 * analysis.highlightFraction) : "; no highlights";
     return text;
 }

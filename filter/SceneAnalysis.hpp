@@ -24,6 +24,9 @@ struct SceneAnalysis {
     float maxCoc = 0.0f;
     std::array<int, kHistogramEdges.size() + 1> histogram{}; ///< pixel counts per |CoC| bin
     bool foreground = false;   ///< some pixel is blurred in front of the focus plane (CoC <= -0.5)
+    /// CV_32FC1 per tile: the largest foreground CoC diameter (pixels) whose blur can reach the
+    /// tile, i.e. the tiles' foreground maxima dilated by the reach of the largest one.
+    cv::Mat tileNearDiameter;
     double highlightFraction = 0.0; ///< pixels above the highlight threshold
     double invalidDepthFraction = 0.0;
 
@@ -45,12 +48,15 @@ struct FramePlan {
     std::vector<cv::Point> copyTiles; ///< tiles only copied (in focus)
     bool holeFill = false;            ///< depth had holes to fill
     bool highlights = false;          ///< the frame has highlights (no highlight pass yet: reported only)
-    bool foreground = false;          ///< the frame has near blur (no near-field pass yet: reported only)
+    bool foreground = false;          ///< the frame has near blur
+    bool nearField = false;           ///< the foreground layer passes run
+    std::vector<cv::Point> nearTiles; ///< tiles the foreground layer covers
 
     /// One line for --explain, e.g. "blur 812/1200 tiles, copy 388; hole fill on (24.1 % invalid)".
     std::string explain(const SceneAnalysis& analysis) const;
 };
 
-FramePlan makePlan(const SceneAnalysis& analysis);
+/// `nearField`: run the foreground layer when the frame has foreground blur.
+FramePlan makePlan(const SceneAnalysis& analysis, bool nearField = true);
 
 } // namespace defocus

@@ -49,6 +49,10 @@ struct QualitySettings {
     /// Follow the per-frame plan: skip every pass when the frame is all in focus and blur only
     /// the tiles that need it. false runs every pass on every pixel (for comparisons).
     bool adaptive = true;
+    /// Spread blurred foreground over what is behind it (a near-field layer, composited over the
+    /// McIntosh result). Runs only on frames, and tiles, with foreground blur. Off by default:
+    /// the published chain keeps pixels in focus unchanged, which the layer does not.
+    bool nearField = false;
 };
 
 /// What the pipeline writes out. The first five are the McIntosh lab's modes 1-5.

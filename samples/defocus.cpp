@@ -300,6 +300,8 @@ int main(int argc, char** argv)
     app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
     app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
     bool alwaysOn = false;
+    app.add_flag("--near-field", o.quality.nearField,
+                 "Spread blurred foreground over what is behind it (a near-field layer; +0.5 dB on the Blender scene)");
     app.add_flag("--always-on", alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
     app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
     app.add_flag("-q,--quiet", o.quiet, "Only the summary line and errors");

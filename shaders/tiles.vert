@@ -7,7 +7,7 @@ layout(location = 0) out vec2 vUv;
 layout(std140, binding = 1) uniform TileParams {
     vec2 targetSize; // pixels
     float tileSize;  // pixels
-    float pad;
+    float tilePad;
 };
 
 void main()

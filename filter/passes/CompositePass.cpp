@@ -1,4 +1,4 @@
-// Composite pass: draws composite.frag over the two diagonal results.
+// Composite pass: draws composite.frag over the two diagonal results (and the near field).
 #include "filter/passes/CompositePass.hpp"
 
 #include "filter/passes/Pass.hpp"
@@ -6,16 +6,25 @@
 namespace defocus {
 
 CompositePass::CompositePass()
-    : program_("fullscreen.vert", "composite.frag", kName), nearest_(GL_NEAREST, "composite nearest")
+    : program_("fullscreen.vert", "composite.frag", kName),
+      nearProgram_("fullscreen.vert", "composite.frag", "composite near", {"NEAR_FIELD 1"}),
+      nearest_(GL_NEAREST, "composite nearest")
 {
 }
 
-void CompositePass::run(const gl::Texture& diagonalA, const gl::Texture& diagonalB, const gl::Framebuffer& target)
+void CompositePass::run(const gl::Texture& diagonalA, const gl::Texture& diagonalB, const gl::Framebuffer& target,
+                        const gl::Texture* nearA, const gl::Texture* nearB)
 {
     target.bindForDraw();
-    program_.use();
     bindTexture(0, diagonalA.id(), nearest_.id());
     bindTexture(1, diagonalB.id(), nearest_.id());
+    if (nearA && nearB) {
+        nearProgram_.use();
+        bindTexture(2, nearA->id(), nearest_.id());
+        bindTexture(3, nearB->id(), nearest_.id());
+    } else {
+        program_.use();
+    }
     drawFullscreenTriangle();
 }
 
