@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "filter/ColorSpace.hpp"
+#include "filter/SceneAnalysis.hpp"
 
 namespace defocus {
 
@@ -70,6 +71,24 @@ void drawLegend(cv::Mat& image, LegendKind kind, float low, float high)
     put(label(kind, low), barLeft);
     put(mid, image.cols / 2 - cv::getTextSize(mid, cv::FONT_HERSHEY_SIMPLEX, textScale, 1, &unused).width / 2);
     put(right, image.cols - margin - cv::getTextSize(right, cv::FONT_HERSHEY_SIMPLEX, textScale, 1, &unused).width);
+}
+
+cv::Mat drawTileMap(const cv::Mat& image, const FramePlan& plan, const SceneAnalysis& analysis)
+{
+    CV_Assert(image.type() == CV_8UC3);
+    cv::Mat map = image.clone();
+    const int T = SceneAnalysis::kTileSize;
+    const auto rect = [&](cv::Point tile) {
+        return cv::Rect(tile.x * T, tile.y * T, T, T) & cv::Rect(0, 0, image.cols, image.rows);
+    };
+    for (const cv::Point tile : plan.copyTiles)
+        map(rect(tile)) *= 0.4;
+    for (const cv::Point tile : plan.nearTiles)
+        map(rect(tile)) = map(rect(tile)) * 0.6 + cv::Scalar(255, 90, 0) * 0.4;
+    for (const cv::Point tile : plan.blurTiles)
+        cv::rectangle(map, rect(tile), cv::Scalar(0, 140, 255), 1);
+    (void)analysis;
+    return map;
 }
 
 cv::Mat contactSheet(const std::vector<std::pair<std::string, cv::Mat>>& tiles, int columns)

@@ -201,6 +201,8 @@ int run(const Options& options)
                 int number = 1;
                 for (const View v : kAllViews)
                     tiles.emplace_back(fmt::format("{} {}", number++, viewName(v)), pipeline.read(v, Encoding::Srgb8));
+                tiles.emplace_back("plan: blur tiles outlined, copied dimmed, near field blue",
+                                   drawTileMap(tiles.front().second, pipeline.plan(), pipeline.analysis()));
                 if (!cv::imwrite(options.contactSheet, contactSheet(tiles)))
                     throw SinkError(fmt::format("cannot write contact sheet '{}'", options.contactSheet));
                 pipeline.run(*frame, lens, options.quality, view, encoding); // keep timings of a plain frame
