@@ -63,7 +63,12 @@ std::vector<SettingIssue> validate(LensSettings& lens, bool clamp)
         if (!(lens.nearLimitM >= 0.0 && lens.nearLimitM < lens.focusM)) {
             issues.push_back({"--near", fmt::format("--near {} m must be in [0, focus {} m)", lens.nearLimitM, lens.focusM)});
             if (clamp)
-                lens.nearLimitM = std::isnan(lens.nearLimitM) ? 0.0 : std::clamp(lens.nearLimitM, 0.0, lens.focusM * 0.99);
+                // Just in front of the focus; with the focus at infinity, the largest finite distance.
+                lens.nearLimitM = std::isnan(lens.nearLimitM)
+                                      ? 0.0
+                                      : std::clamp(lens.nearLimitM, 0.0,
+                                                   std::isinf(lens.focusM) ? std::numeric_limits<double>::max()
+                                                                           : lens.focusM * 0.99);
         }
         // +inf is the closed end of (focus, +inf], so it stays allowed when the focus is at infinity.
         if (!(lens.farLimitM > lens.focusM || lens.farLimitM == std::numeric_limits<double>::infinity())) {

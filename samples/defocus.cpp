@@ -178,12 +178,14 @@ int run(const Options& options)
     std::map<std::string, double> passMs;
     double totalMs = 0, uploadMs = 0, readbackMs = 0;
     std::size_t framesIn = 0, timed = 0;
+    std::size_t current = 0; // index of the frame being read or processed, for messages
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
 
     int exitCode = kOk;
     try {
         while (!gStop && (!options.frames || framesIn < *options.frames)) {
+            current = framesIn;
             std::optional<Frame> frame = source->next();
             if (!frame)
                 break;
@@ -224,7 +226,7 @@ int run(const Options& options)
         }
     } catch (const std::exception& error) {
         progress.finish();
-        spdlog::error("frame {}: {}", framesIn, error.what());
+        spdlog::error("frame {}: {}", current, error.what());
         exitCode = kFailure;
     }
     sink->finish();

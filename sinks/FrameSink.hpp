@@ -35,7 +35,7 @@ public:
     virtual void finish() = 0;
     /// Frames written so far.
     virtual std::size_t framesWritten() const = 0;
-    /// One line for logs, e.g. "video out.mp4 (mp4v, 30 fps)".
+    /// One line for logs, e.g. "video 'out.mp4' (mp4v, 30 fps, 120 frames)".
     virtual std::string describe() const = 0;
 };
 

@@ -90,8 +90,8 @@ void writeAtomically(const fs::path& file, const cv::Mat& image)
     const std::string ext = lowerExtension(file);
     if (ext == ".exr")
         enableOpenExr();
-    const fs::path partial = file.parent_path() /
-                             ("." + file.stem().string() + ".partial" + file.extension().string());
+    const fs::path partial =
+        file.parent_path() / fmt::format(".{}.partial{}", file.stem().string(), file.extension().string());
     bool written = false;
     std::string reason = "the encoder failed";
     try {
@@ -116,8 +116,9 @@ void writeAtomically(const fs::path& file, const cv::Mat& image)
 ImageSequenceSink::ImageSequenceSink(fs::path folder, bool linear)
     : folder_(std::move(folder)), linear_(linear)
 {
-    prepareFolder(folder_, folder_);
     std::error_code ec;
+    createdFolder_ = !fs::exists(folder_, ec);
+    prepareFolder(folder_, folder_);
     if (fs::exists(framePath(0), ec))
         spdlog::warn("sequence '{}': the folder already holds frames; they will be overwritten",
                      folder_.string());
@@ -141,10 +142,21 @@ void ImageSequenceSink::write(const cv::Mat& image)
     ++written_;
 }
 
+void ImageSequenceSink::finish()
+{
+    if (finished_)
+        return;
+    finished_ = true;
+    std::error_code ec;
+    if (written_ == 0 && createdFolder_ && fs::is_empty(folder_, ec) && fs::remove(folder_, ec))
+        spdlog::warn("sequence '{}': no frames written, so the folder it created is removed",
+                     folder_.string());
+}
+
 std::string ImageSequenceSink::describe() const
 {
-    return fmt::format("{} sequence '{}' (frame_NNNNNN{})", linear_ ? "EXR" : "PNG",
-                       folder_.string(), linear_ ? ".exr" : ".png");
+    return fmt::format("{} sequence '{}' (frame_NNNNNN{}, {} frames)", linear_ ? "EXR" : "PNG",
+                       folder_.string(), linear_ ? ".exr" : ".png", written_);
 }
 
 SingleImageSink::SingleImageSink(fs::path file) : file_(std::move(file))

@@ -20,7 +20,10 @@ public:
 
     SinkEncoding encoding() const override;
     void write(const cv::Mat& image) override;
-    void finish() override {}
+    /// Frames are complete files as soon as write() returns, so after a failure in the middle of
+    /// a clip the earlier frames stay as they are. With no frame written, a folder that the
+    /// constructor created is removed again (with a warning), so a failed run leaves no output.
+    void finish() override;
     std::size_t framesWritten() const override { return written_; }
     std::string describe() const override;
 
@@ -30,6 +33,8 @@ public:
 private:
     std::filesystem::path folder_;
     bool linear_;
+    bool createdFolder_ = false;
+    bool finished_ = false;
     std::size_t written_ = 0;
 };
 

@@ -172,7 +172,7 @@ void VideoSink::finish()
 
 std::string VideoSink::describe() const
 {
-    return fmt::format("video '{}' ({}, {:g} fps)", file_.string(), codec_, fps_);
+    return fmt::format("video '{}' ({}, {:g} fps, {} frames)", file_.string(), codec_, fps_, written_);
 }
 
 } // namespace defocus

@@ -26,6 +26,9 @@ public:
     SinkEncoding encoding() const override { return SinkEncoding::Srgb8; }
     /// The first frame fixes the size; a frame of another size throws SinkError.
     void write(const cv::Mat& image) override;
+    /// Closes the container and renames it into place. Also the path after a failure in the
+    /// middle of a clip: the frames written so far become a playable, shorter video. With no
+    /// frame written, the partial file is deleted and no file is created.
     void finish() override;
     std::size_t framesWritten() const override { return written_; }
     std::string describe() const override;

@@ -21,8 +21,8 @@ namespace fs = std::filesystem;
 
 bool isImageFile(const fs::path& file)
 {
-    static constexpr std::array<std::string_view, 7> extensions = {
-        ".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".bmp"};
+    static constexpr std::array<std::string_view, 8> extensions = {
+        ".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".bmp", ".webp"};
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -100,7 +100,7 @@ FolderPairSource::FolderPairSource(fs::path colorFolder, std::optional<fs::path>
     colorFiles_ = listImages(colorFolder_);
     if (colorFiles_.empty())
         throw SourceError(fmt::format(
-            "folder '{}' holds no images (png, jpg, jpeg, exr, tif, tiff or bmp)",
+            "folder '{}' holds no images (png, jpg, jpeg, exr, tif, tiff, bmp or webp)",
             colorFolder_.string()));
     std::error_code ec;
     if (!depth_) {
@@ -128,6 +128,9 @@ std::optional<Frame> FolderPairSource::next()
         frame.depth = readDepth(depthFiles_[next_], unitsPerMetre_);
     else if (!sharedDepth_.empty())
         frame.depth = sharedDepth_.clone(); // each frame owns its pixels
+    if (!frame.depth.empty())
+        checkDepthFits(frame.color.size(), colorFiles_[next_].string(), frame.depth.size(),
+                       depthFiles_.empty() ? depth_->string() : depthFiles_[next_].string());
     frame.index = next_;
     frame.name = colorFiles_[next_].filename().string();
     ++next_;

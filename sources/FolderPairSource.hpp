@@ -14,11 +14,12 @@ namespace defocus {
 
 class FolderPairSource final : public FrameSource {
 public:
-    /// Lists the images (png, jpg, jpeg, exr, tif, tiff, bmp; hidden files skipped) of both
+    /// Lists the images (png, jpg, jpeg, exr, tif, tiff, bmp, webp; hidden files skipped) of both
     /// folders in natural name order ("f2" before "f10") and pairs them one to one. `depth`: a
     /// folder with as many images as `colorFolder`, a single depth image used for every frame,
     /// or none (frames pass through in focus). `unitsPerMetre`: scale of 16-bit depth images.
-    /// Throws SourceError for an empty folder or unequal counts.
+    /// Throws SourceError for an empty folder or unequal counts (naming both folders and counts),
+    /// and from next() for an unreadable image or a depth of another aspect ratio than its colour.
     FolderPairSource(std::filesystem::path colorFolder, std::optional<std::filesystem::path> depth,
                      double unitsPerMetre);
 

@@ -13,6 +13,7 @@
 
 #include "sources/FolderPairSource.hpp"
 #include "sources/SingleImageSource.hpp"
+#include "sources/StreamSources.hpp" // streams (issue 5)
 #include "sources/TumSource.hpp"
 #include "sources/VideoFileSource.hpp"
 
@@ -52,6 +53,9 @@ std::unique_ptr<FrameSource> openSource(const SourceOptions& options)
         throw SourceError(fmt::format(
             "depth scale must be a positive number of units per metre, got {}",
             *options.depthScale));
+    // ---- streams (issue 5): cameras, and video files with a depth sequence ----
+    if (std::unique_ptr<FrameSource> stream = openStreamSource(options))
+        return stream;
 
     if (fs::is_directory(input, ec)) {
         if (fs::exists(input / "rgb.txt", ec) || fs::exists(input / "associations.txt", ec)) {

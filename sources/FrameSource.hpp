@@ -16,7 +16,23 @@
 namespace defocus {
 
 /// Thrown for anything wrong with the input on disk; the message names the file (and line or
-/// frame) and what is wrong with it.
+/// frame) and what is wrong with it. What each kind of bad input gives:
+///   missing input, depth or listed file ... SourceError at open ("LIST:LINE: listed file ... does
+///                                            not exist" for TUM lists)
+///   corrupt or truncated image ............. SourceError naming the file, from the first read of
+///                                            it; unknown formats and sizes over kMaxImagePixels
+///                                            are refused before decoding (ImageIO.hpp)
+///   truncated or damaged video ............. a file that does not open: SourceError at open; one
+///                                            that stops early: a warning with both frame counts,
+///                                            and the frames decoded so far go through
+///   depth of another size than colour ...... scaled to the colour size by the pipeline; another
+///                                            aspect ratio: SourceError naming both files and sizes
+///   unequal colour and depth counts ........ folder pair: SourceError at open naming both folders
+///                                            and counts; TUM: colour frames with no depth within
+///                                            20 ms pass through in focus, with one warning
+///   wrong bit depth or channel count ....... SourceError naming the file and its sample format
+///   empty folder or list ................... SourceError at open naming it
+///   garbage line in a TUM list ............. SourceError "LIST:LINE: expected '...', got '...'"
 class SourceError : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
@@ -34,6 +50,10 @@ public:
     virtual double frameRate() const { return 0.0; }
     /// One line for logs: kind and location, e.g. "TUM RGB-D sequence data/tum (10 pairs)".
     virtual std::string describe() const = 0;
+    // ---- streams (issue 5) ----
+    /// True for sources that capture in real time (cameras): they do not end by themselves, and
+    /// a consumer slower than the source drops frames rather than queueing them.
+    virtual bool isLive() const { return false; }
 };
 
 struct SourceOptions {
@@ -44,6 +64,13 @@ struct SourceOptions {
     std::optional<std::filesystem::path> depth;
     /// Units per metre of 16-bit depth images. Unset: 5000 for the TUM layout, 1000 otherwise.
     std::optional<double> depthScale;
+    // ---- streams (issue 5): `input` may also be a camera (/dev/video*), with `depth` a second
+    // camera giving Z16 depth; a video file may take a depth folder or depth.txt (by index).
+    /// Capture size asked of a camera, pixels (> 0); the driver picks the nearest it has.
+    int width = 640;
+    int height = 480;
+    /// Frame rate asked of a camera, Hz (> 0); the driver picks the nearest it has.
+    double fps = 30.0;
 };
 
 /// Opens the source that `options.input` names; throws SourceError with a clear message when

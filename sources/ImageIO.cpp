@@ -2,9 +2,14 @@
 // (colour: 8-bit sRGB or float linear BGR; depth: float metres).
 #include "sources/ImageIO.hpp"
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <limits>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -14,6 +19,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sources/FrameSource.hpp"
+#include "sources/ImageHeader.hpp"
 
 namespace defocus {
 namespace {
@@ -46,10 +52,8 @@ bool isFloat(const cv::Mat& image)
     return image.depth() == CV_32F || image.depth() == CV_64F || image.depth() == CV_16F;
 }
 
-// imread with IMREAD_UNCHANGED: the caller decides what each bit depth and channel count means.
-cv::Mat load(const fs::path& file, const char* what)
+std::vector<unsigned char> readBytes(const fs::path& file, const char* what)
 {
-    enableOpenExr();
     std::error_code ec;
     if (!fs::exists(file, ec))
         throw SourceError(
@@ -57,22 +61,60 @@ cv::Mat load(const fs::path& file, const char* what)
     if (fs::is_directory(file, ec))
         throw SourceError(
             fmt::format("cannot read {} image '{}': it is a folder", what, file.string()));
+    std::ifstream in(file, std::ios::binary);
+    std::vector<unsigned char> bytes;
+    if (in)
+        bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (!in && !in.eof())
+        throw SourceError(fmt::format("cannot read {} image '{}': {}", what, file.string(),
+                                      std::generic_category().message(errno)));
+    return bytes;
+}
+
+// Checks the header (format, size, completeness), then decodes with IMREAD_UNCHANGED: the caller
+// decides what each bit depth and channel count means. `file`, when given, is decoded from disk
+// (OpenCV's EXR decoder cannot read from memory and would copy the bytes to a temporary file).
+cv::Mat decode(std::span<const unsigned char> bytes, const std::string& name, const char* what,
+               std::size_t maxPixels, const fs::path* file)
+{
+    enableOpenExr();
+    // OpenCV's own hard limit on each side (CV_IO_MAX_IMAGE_WIDTH and _HEIGHT).
+    constexpr std::uint64_t maxSide = std::uint64_t{1} << 20;
+    const ImageHeader header = readImageHeader(bytes);
+    if (!header.problem.empty())
+        throw SourceError(fmt::format("cannot read {} image '{}': {}", what, name, header.problem));
+    if (header.width > maxSide || header.height > maxSide || header.width * header.height > maxPixels)
+        throw SourceError(fmt::format("cannot read {} image '{}': the {} header gives {}x{} pixels, more "
+                                      "than the {} allowed ({} per side)",
+                                      what, name, formatName(header.format), header.width, header.height,
+                                      maxPixels, maxSide));
+    if (header.tilePixels > maxPixels)
+        throw SourceError(fmt::format("cannot read {} image '{}': its TIFF tiles have {} pixels, more than "
+                                      "the {} allowed",
+                                      what, name, header.tilePixels, maxPixels));
+    if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+        throw SourceError(fmt::format("cannot read {} image '{}': files over 2 GiB are not supported",
+                                      what, name));
     cv::Mat image;
     try {
-        image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+        if (file && header.format == ImageFormat::OpenExr) {
+            image = cv::imread(file->string(), cv::IMREAD_UNCHANGED);
+        } else {
+            const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1,
+                                  const_cast<unsigned char*>(bytes.data()));
+            image = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);
+        }
     } catch (const cv::Exception& e) {
-        throw SourceError(fmt::format("cannot read {} image '{}': {}", what, file.string(), e.err));
+        throw SourceError(fmt::format("cannot read {} image '{}': {}", what, name, e.err));
     }
     if (image.empty())
-        throw SourceError(fmt::format(
-            "cannot read {} image '{}': not a decodable image (corrupt, truncated or an "
-            "unsupported format)",
-            what, file.string()));
+        throw SourceError(fmt::format("cannot read {} image '{}': the {} decoder failed (corrupt data)",
+                                      what, name, formatName(header.format)));
     return image;
 }
 
 // Grey -> BGR, BGRA -> BGR (alpha dropped); any depth cvtColor supports (8U, 16U, 32F).
-cv::Mat toBgr(const cv::Mat& image, const fs::path& file)
+cv::Mat toBgr(const cv::Mat& image, const std::string& name)
 {
     cv::Mat bgr;
     switch (image.channels()) {
@@ -88,7 +130,7 @@ cv::Mat toBgr(const cv::Mat& image, const fs::path& file)
         throw SourceError(fmt::format(
             "cannot read colour image '{}': it is {}; expected 1 (grey), 3 (colour) or 4 "
             "(colour + alpha) channels",
-            file.string(), describeSamples(image)));
+            name, describeSamples(image)));
     }
 }
 
@@ -122,33 +164,33 @@ cv::Mat decode16BitSrgb(const cv::Mat& bgr16)
     return linear;
 }
 
-} // namespace
-
-cv::Mat readColor(const fs::path& file)
+cv::Mat colorFromRaw(const cv::Mat& raw, const std::string& name)
 {
-    const cv::Mat raw = load(file, "colour");
     if (raw.depth() == CV_8U)
-        return toBgr(raw, file);
+        return toBgr(raw, name);
     if (raw.depth() == CV_16U)
-        return decode16BitSrgb(toBgr(raw, file));
+        return decode16BitSrgb(toBgr(raw, name));
     if (isFloat(raw)) {
         cv::Mat f;
         raw.convertTo(f, CV_32F);
-        return toBgr(f, file);
+        return toBgr(f, name);
     }
     throw SourceError(fmt::format(
-        "cannot read colour image '{}': it is {}; expected 8-bit, 16-bit or float samples",
-        file.string(), describeSamples(raw)));
+        "cannot read colour image '{}': it is {}; expected 8-bit, 16-bit or float samples", name,
+        describeSamples(raw)));
 }
 
-cv::Mat readDepth(const fs::path& file, double unitsPerMetre)
+void checkDepthScale(double unitsPerMetre, const std::string& name)
 {
     if (!(unitsPerMetre > 0.0) || !std::isfinite(unitsPerMetre))
         throw SourceError(fmt::format(
             "cannot read depth image '{}': the depth scale must be a positive number of units "
             "per metre, got {}",
-            file.string(), unitsPerMetre));
-    const cv::Mat raw = load(file, "depth");
+            name, unitsPerMetre));
+}
+
+cv::Mat depthFromRaw(const cv::Mat& raw, double unitsPerMetre, const std::string& name)
+{
     cv::Mat metres;
     if (raw.depth() == CV_16U && raw.channels() == 1) {
         // 0 (no measurement) stays 0.
@@ -166,7 +208,51 @@ cv::Mat readDepth(const fs::path& file, double unitsPerMetre)
     throw SourceError(fmt::format(
         "cannot read depth image '{}': it is {}; expected 16-bit single-channel ({} units per "
         "metre) or float metres (EXR, TIFF)",
-        file.string(), describeSamples(raw), unitsPerMetre));
+        name, describeSamples(raw), unitsPerMetre));
+}
+
+} // namespace
+
+cv::Mat decodeColor(std::span<const unsigned char> bytes, const std::string& name, std::size_t maxPixels)
+{
+    return colorFromRaw(decode(bytes, name, "colour", maxPixels, nullptr), name);
+}
+
+cv::Mat readColor(const fs::path& file)
+{
+    const std::vector<unsigned char> bytes = readBytes(file, "colour");
+    return colorFromRaw(decode(bytes, file.string(), "colour", kMaxImagePixels, &file), file.string());
+}
+
+cv::Mat decodeDepth(std::span<const unsigned char> bytes, double unitsPerMetre, const std::string& name,
+                    std::size_t maxPixels)
+{
+    checkDepthScale(unitsPerMetre, name);
+    return depthFromRaw(decode(bytes, name, "depth", maxPixels, nullptr), unitsPerMetre, name);
+}
+
+cv::Mat readDepth(const fs::path& file, double unitsPerMetre)
+{
+    checkDepthScale(unitsPerMetre, file.string());
+    const std::vector<unsigned char> bytes = readBytes(file, "depth");
+    return depthFromRaw(decode(bytes, file.string(), "depth", kMaxImagePixels, &file), unitsPerMetre,
+                        file.string());
+}
+
+void checkDepthFits(const cv::Size& colorSize, const std::string& colorName, const cv::Size& depthSize,
+                    const std::string& depthName)
+{
+    if (depthSize == colorSize || colorSize.empty() || depthSize.empty())
+        return;
+    const double expectedHeight = static_cast<double>(depthSize.width) * colorSize.height / colorSize.width;
+    if (std::abs(depthSize.height - expectedHeight) <= std::max(1.0, 0.01 * depthSize.height))
+        return;
+    throw SourceError(fmt::format(
+        "depth '{}' is {}x{} but colour '{}' is {}x{}: their aspect ratios ({:.3f} and {:.3f}) differ; "
+        "depth of another size is scaled to the colour, so it must have the same aspect ratio",
+        depthName, depthSize.width, depthSize.height, colorName, colorSize.width, colorSize.height,
+        static_cast<double>(depthSize.width) / depthSize.height,
+        static_cast<double>(colorSize.width) / colorSize.height));
 }
 
 } // namespace defocus

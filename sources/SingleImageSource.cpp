@@ -18,6 +18,8 @@ SingleImageSource::SingleImageSource(std::filesystem::path colorFile,
     frame_.name = colorFile.filename().string();
     if (depthFile) {
         frame_.depth = readDepth(*depthFile, unitsPerMetre);
+        checkDepthFits(frame_.color.size(), colorFile.string(), frame_.depth.size(),
+                       depthFile->string());
         description_ = fmt::format("image '{}' + depth '{}'", colorFile.string(),
                                    depthFile->string());
     } else {

@@ -14,7 +14,8 @@ namespace defocus {
 class SingleImageSource final : public FrameSource {
 public:
     /// Reads both files at once, so that a bad file fails before any output. Without `depthFile`
-    /// the frame has no depth and passes through in focus (logged as a warning).
+    /// the frame has no depth and passes through in focus (logged as a warning). Throws
+    /// SourceError for an unreadable file or a depth of another aspect ratio than the colour.
     SingleImageSource(std::filesystem::path colorFile,
                       std::optional<std::filesystem::path> depthFile, double unitsPerMetre);
 

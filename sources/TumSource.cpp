@@ -3,11 +3,7 @@
 #include "sources/TumSource.hpp"
 
 #include <algorithm>
-#include <charconv>
-#include <cmath>
 #include <fstream>
-#include <sstream>
-#include <string_view>
 #include <system_error>
 #include <utility>
 
@@ -15,67 +11,19 @@
 #include <spdlog/spdlog.h>
 
 #include "sources/ImageIO.hpp"
+#include "sources/TumLists.hpp"
 
 namespace defocus {
 namespace {
 
 namespace fs = std::filesystem;
 
-/// One non-comment line of a list file, split at white space.
-struct ListLine {
-    std::size_t number = 0; // from 1
-    std::string text;
-    std::vector<std::string> tokens;
-};
-
-/// One "timestamp filename" entry of rgb.txt or depth.txt.
-struct Listed {
-    double time = 0.0;
-    fs::path file;
-    std::size_t line = 0;
-};
-
-std::vector<ListLine> readListFile(const fs::path& file)
+std::ifstream openList(const fs::path& file)
 {
     std::ifstream in(file);
     if (!in)
         throw SourceError(fmt::format("cannot open '{}'", file.string()));
-    std::vector<ListLine> lines;
-    std::string text;
-    std::size_t number = 0;
-    while (std::getline(in, text)) {
-        ++number;
-        if (!text.empty() && text.back() == '\r')
-            text.pop_back();
-        std::istringstream words(text);
-        std::vector<std::string> tokens;
-        for (std::string word; words >> word;)
-            tokens.push_back(std::move(word));
-        if (tokens.empty() || tokens.front().front() == '#')
-            continue;
-        lines.push_back({number, std::move(text), std::move(tokens)});
-    }
-    if (in.bad())
-        throw SourceError(fmt::format("cannot read '{}'", file.string()));
-    return lines;
-}
-
-std::optional<double> parseTime(const std::string& token)
-{
-    double value = 0.0;
-    const char* end = token.data() + token.size();
-    const auto [ptr, ec] = std::from_chars(token.data(), end, value);
-    if (ec != std::errc() || ptr != end || !std::isfinite(value))
-        return std::nullopt;
-    return value;
-}
-
-[[noreturn]] void badLine(const fs::path& list, const ListLine& line, std::string_view expected)
-{
-    constexpr std::size_t shown = 60;
-    std::string text = line.text.size() > shown ? line.text.substr(0, shown) + "..." : line.text;
-    throw SourceError(
-        fmt::format("{}:{}: expected '{}', got '{}'", list.string(), line.number, expected, text));
+    return in;
 }
 
 void requireFile(const fs::path& folder, const fs::path& list, std::size_t line,
@@ -83,48 +31,10 @@ void requireFile(const fs::path& folder, const fs::path& list, std::size_t line,
 {
     std::error_code ec;
     if (!fs::is_regular_file(folder / listed, ec))
-        throw SourceError(fmt::format("{}:{}: listed file '{}' does not exist", list.string(), line,
-                                      (folder / listed).string()));
-}
-
-std::vector<Listed> readTimestampList(const fs::path& list)
-{
-    std::vector<Listed> entries;
-    for (const ListLine& line : readListFile(list)) {
-        const std::optional<double> time =
-            line.tokens.size() == 2 ? parseTime(line.tokens[0]) : std::nullopt;
-        if (!time)
-            badLine(list, line, "timestamp file");
-        entries.push_back({*time, line.tokens[1], line.number});
-    }
-    return entries;
-}
-
-// The median frame interval finds dropped frames (gaps of 1.5 intervals or more); the rate is
-// the mean over the other intervals. The median alone is biased by the capture clock's jitter:
-// TUM fr1 steps of 31, 32 and 36 ms have a 32 ms median (31.2 Hz) for a 30 Hz camera.
-double estimateFrameRate(std::vector<double> times)
-{
-    constexpr double fallback = 30.0;
-    std::sort(times.begin(), times.end());
-    std::vector<double> steps;
-    for (std::size_t i = 1; i < times.size(); ++i)
-        if (times[i] > times[i - 1])
-            steps.push_back(times[i] - times[i - 1]);
-    if (steps.empty())
-        return fallback;
-    std::vector<double> sorted = steps;
-    const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
-    std::nth_element(sorted.begin(), middle, sorted.end());
-    const double median = *middle;
-    double sum = 0.0;
-    std::size_t count = 0;
-    for (double step : steps)
-        if (step < 1.5 * median) {
-            sum += step;
-            ++count;
-        }
-    return count > 0 && sum > 0.0 ? static_cast<double>(count) / sum : fallback;
+        throw SourceError(fmt::format("{}:{}: listed file '{}' {}", list.string(), line,
+                                      (folder / listed).string(),
+                                      fs::exists(folder / listed, ec) ? "is not a regular file"
+                                                                      : "does not exist"));
 }
 
 } // namespace
@@ -154,55 +64,39 @@ TumSource::TumSource(fs::path folder, double unitsPerMetre)
     std::vector<double> times;
     for (const Entry& e : entries_)
         times.push_back(e.rgbTime);
-    frameRate_ = estimateFrameRate(std::move(times));
+    frameRate_ = tum::estimateFrameRate(std::move(times));
 }
 
 void TumSource::readAssociations(const fs::path& list)
 {
     pairing_ = "associations.txt";
-    for (const ListLine& line : readListFile(list)) {
-        const std::optional<double> rgbTime =
-            line.tokens.size() == 4 ? parseTime(line.tokens[0]) : std::nullopt;
-        const std::optional<double> depthTime =
-            line.tokens.size() == 4 ? parseTime(line.tokens[2]) : std::nullopt;
-        if (!rgbTime || !depthTime)
-            badLine(list, line, "timestamp file timestamp file");
-        requireFile(folder_, list, line.number, line.tokens[1]);
-        requireFile(folder_, list, line.number, line.tokens[3]);
-        entries_.push_back({*rgbTime, line.tokens[1], fs::path(line.tokens[3])});
+    std::ifstream in = openList(list);
+    for (const tum::Association& a : tum::parseAssociations(in, list)) {
+        requireFile(folder_, list, a.rgb.line, a.rgb.file);
+        requireFile(folder_, list, a.depth.line, a.depth.file);
+        entries_.push_back({a.rgb.time, a.rgb.file, a.depth.file});
     }
 }
 
 void TumSource::pairByTimestamp(const fs::path& rgbList, const fs::path& depthList)
 {
     pairing_ = "nearest timestamp";
-    const std::vector<Listed> rgb = readTimestampList(rgbList);
-    std::vector<Listed> depth = readTimestampList(depthList);
-    std::stable_sort(depth.begin(), depth.end(),
-                     [](const Listed& a, const Listed& b) { return a.time < b.time; });
+    std::ifstream rgbIn = openList(rgbList);
+    const std::vector<tum::Listed> rgb = tum::parseTimestampList(rgbIn, rgbList);
+    std::ifstream depthIn = openList(depthList);
+    const std::vector<tum::Listed> depth = tum::parseTimestampList(depthIn, depthList);
+    const std::vector<std::optional<std::size_t>> pairs = tum::pairByTimestamp(rgb, depth, maxPairingGap);
 
-    // A microsecond of slack: the lists print six decimals, so a gap of exactly 20 ms may parse
-    // as a hair more.
-    constexpr double slack = 1e-6;
     std::size_t unpaired = 0;
     std::string firstUnpaired;
-    for (const Listed& colour : rgb) {
+    for (std::size_t i = 0; i < rgb.size(); ++i) {
+        const tum::Listed& colour = rgb[i];
         requireFile(folder_, rgbList, colour.line, colour.file);
         Entry entry{colour.time, colour.file, std::nullopt};
-        const auto after = std::lower_bound(
-            depth.begin(), depth.end(), colour.time,
-            [](const Listed& d, double t) { return d.time < t; });
-        const Listed* nearest = nullptr;
-        if (after != depth.end())
-            nearest = &*after;
-        if (after != depth.begin()) {
-            const Listed& before = *std::prev(after);
-            if (!nearest || colour.time - before.time <= nearest->time - colour.time)
-                nearest = &before;
-        }
-        if (nearest && std::abs(nearest->time - colour.time) <= maxPairingGap + slack) {
-            requireFile(folder_, depthList, nearest->line, nearest->file);
-            entry.depth = nearest->file;
+        if (pairs[i]) {
+            const tum::Listed& paired = depth[*pairs[i]];
+            requireFile(folder_, depthList, paired.line, paired.file);
+            entry.depth = paired.file;
         } else {
             if (unpaired++ == 0)
                 firstUnpaired = colour.file.generic_string();
@@ -225,8 +119,11 @@ std::optional<Frame> TumSource::next()
     const Entry& entry = entries_[next_];
     Frame frame;
     frame.color = readColor(folder_ / entry.rgb);
-    if (entry.depth)
+    if (entry.depth) {
         frame.depth = readDepth(folder_ / *entry.depth, unitsPerMetre_);
+        checkDepthFits(frame.color.size(), (folder_ / entry.rgb).string(), frame.depth.size(),
+                       (folder_ / *entry.depth).string());
+    }
     frame.timestamp = entry.rgbTime;
     frame.index = next_;
     frame.name = entry.rgb.generic_string();

@@ -23,6 +23,8 @@ public:
     /// Throws SourceError naming the list file and line.
     TumSource(std::filesystem::path folder, double unitsPerMetre);
 
+    /// Throws SourceError naming the file for an unreadable image, or both files for a depth of
+    /// another aspect ratio than its colour.
     std::optional<Frame> next() override;
     std::optional<std::size_t> frameCount() const override;
     double frameRate() const override;

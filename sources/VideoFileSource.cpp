@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio/registry.hpp>
 #include <spdlog/spdlog.h>
 
 #include "sources/ImageIO.hpp"
@@ -23,8 +24,11 @@ VideoFileSource::VideoFileSource(std::filesystem::path file,
         throw SourceError(fmt::format(
             "video '{}': depth '{}' is a folder; a video takes one depth image for all frames",
             file_.string(), depthFile_->string()));
+    // FFmpeg directly where it exists: with CAP_ANY a file FFmpeg rejects falls through to the
+    // image-sequence backend, whose own error about file name patterns only confuses the log.
+    const int api = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY;
     try {
-        capture_.open(file_.string(), cv::CAP_ANY);
+        capture_.open(file_.string(), api);
     } catch (const cv::Exception& e) {
         throw SourceError(fmt::format("cannot open video '{}': {}", file_.string(), e.err));
     }
@@ -60,6 +64,10 @@ std::optional<Frame> VideoFileSource::next()
     if (!read || image.empty()) {
         ended_ = true;
         capture_.release();
+        if (frameCount_ && next_ < *frameCount_)
+            spdlog::warn("video '{}': decoding stopped after {} of the {} frames its header states; "
+                         "the file is truncated or damaged, and the frames written so far are kept",
+                         file_.string(), next_, *frameCount_);
         return std::nullopt;
     }
     Frame frame;
@@ -72,8 +80,11 @@ std::optional<Frame> VideoFileSource::next()
     else
         throw SourceError(fmt::format("video '{}': frame {} has unsupported pixel type {}",
                                       file_.string(), next_, cv::typeToString(image.type())));
-    if (!depth_.empty())
+    if (!depth_.empty()) {
+        checkDepthFits(frame.color.size(), fmt::format("{} frame {}", file_.string(), next_),
+                       depth_.size(), depthFile_->string());
         frame.depth = depth_.clone(); // each frame owns its pixels
+    }
     const double msec = capture_.get(cv::CAP_PROP_POS_MSEC);
     frame.timestamp = std::isfinite(msec) && msec >= 0.0 ? msec / 1000.0
                       : frameRate_ > 0.0                  ? static_cast<double>(next_) / frameRate_

@@ -21,6 +21,9 @@ public:
     VideoFileSource(std::filesystem::path file, std::optional<std::filesystem::path> depthFile,
                     double unitsPerMetre);
 
+    /// Throws SourceError when a frame cannot be decoded or the depth has another aspect ratio.
+    /// A stream that ends before the frame count the container states (a truncated file) ends
+    /// with a warning naming both counts: the frames decoded so far are processed and kept.
     std::optional<Frame> next() override;
     /// The container's frame count, when it states one (it may be an estimate).
     std::optional<std::size_t> frameCount() const override;

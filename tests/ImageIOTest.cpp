@@ -202,6 +202,33 @@ TEST(ImageIO, TruncatedAndCorruptFilesGiveSourceErrorNamingThePath)
     EXPECT_NE(m.find("does not exist"), std::string::npos) << m;
 }
 
+TEST(ImageIO, DecodingFromMemoryMatchesReadingTheFile)
+{
+    const fs::path dir = test::scratchDir("ImageIO_memory");
+    cv::Mat depth(6, 8, CV_16UC1);
+    cv::randu(depth, 0, 60000);
+    writeFixture(dir / "depth.png", depth);
+    cv::Mat hdr(6, 8, CV_32FC3);
+    cv::randu(hdr, 0.0f, 50.0f);
+    writeFixture(dir / "color.exr", hdr);
+    const auto bytesOf = [](const fs::path& file) {
+        std::ifstream in(file, std::ios::binary);
+        return std::vector<unsigned char>(std::istreambuf_iterator<char>(in), {});
+    };
+
+    const cv::Mat fromMemory = decodeDepth(bytesOf(dir / "depth.png"), 1000.0, "mem.png");
+    EXPECT_EQ(cv::norm(fromMemory, readDepth(dir / "depth.png", 1000.0), cv::NORM_INF), 0.0);
+    const cv::Mat colour = decodeColor(bytesOf(dir / "color.exr"), "mem.exr");
+    EXPECT_EQ(cv::norm(colour, readColor(dir / "color.exr"), cv::NORM_INF), 0.0);
+
+    // The pixel limit is checked on the header: one pixel less than the image is refused.
+    const std::string message = messageOf([&] { decodeColor(bytesOf(dir / "color.exr"), "mem.exr", 47); });
+    EXPECT_NE(message.find("cannot read colour image 'mem.exr': the OpenEXR header gives 8x6 pixels, more than "
+                           "the 47 allowed"),
+              std::string::npos)
+        << message;
+}
+
 TEST(ImageIO, NonPositiveDepthScaleIsRejected)
 {
     const fs::path file = test::dataDir() / "tum_fr1_rpy/depth/1305031250.253735.png";

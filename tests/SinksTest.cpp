@@ -99,6 +99,24 @@ TEST(ImageSequenceSink, WrongFrameTypeIsASinkError)
     EXPECT_EQ(sink->framesWritten(), 0u);
 }
 
+TEST(ImageSequenceSink, FolderItCreatedIsRemovedWhenNoFrameWasWritten)
+{
+    const fs::path dir = test::scratchDir("Sink_sequence_unused");
+    openSink({dir.string() + "/new/", 30.0, false})->finish();
+    EXPECT_FALSE(fs::exists(dir / "new")); // a failed run leaves no empty output folder
+
+    const std::unique_ptr<FrameSink> existing = openSink({dir, 30.0, false});
+    existing->finish();
+    EXPECT_TRUE(fs::is_directory(dir)); // one that was there before stays
+
+    const std::unique_ptr<FrameSink> used = openSink({dir / "used/", 30.0, false});
+    used->write(testFrame(0));
+    used->finish();
+    used->finish();
+    EXPECT_EQ(fileNames(dir / "used"), std::vector<std::string>{"frame_000000.png"});
+    EXPECT_NE(used->describe().find("1 frames"), std::string::npos) << used->describe();
+}
+
 // Writes `count` frames and reads the file back: frame count, size and (lossy) content.
 void checkVideoRoundTrip(const std::string& extension, const std::string& expectedCodec)
 {

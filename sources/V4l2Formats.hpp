@@ -1,0 +1,72 @@
+// Conversions of V4L2 pixel formats into what a Frame holds: colour formats to BGR CV_8UC3,
+// Z16 depth to metres. Pure functions on bytes, so tests check them without a camera.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include <opencv2/core.hpp>
+
+namespace defocus::v4l2 {
+
+/// "YUYV" for V4L2_PIX_FMT_YUYV, "Z16 " for V4L2_PIX_FMT_Z16; unprintable bytes become '?'.
+std::string fourccName(std::uint32_t fourcc);
+/// The code of a 1-4 character name ("MJPG", "Z16"; shorter names are padded with spaces, as
+/// V4L2 spells them). Names longer than 4 characters give 0.
+std::uint32_t fourccFromName(std::string_view name);
+
+/// The formats V4l2Source decodes: YUYV, NV12, RGB3, BGR3, GREY, MJPG (colour) and Z16 (depth).
+bool isColorFormat(std::uint32_t fourcc);
+bool isDepthFormat(std::uint32_t fourcc);
+
+/// One captured image as the driver lays it out (from VIDIOC_S_FMT).
+struct PixelLayout {
+    std::uint32_t fourcc = 0;     ///< V4L2_PIX_FMT_*
+    int width = 0;                ///< pixels, > 0
+    int height = 0;               ///< pixels, > 0
+    std::size_t bytesPerLine = 0; ///< stride of the first plane in bytes; 0 = tightly packed
+};
+
+/// The stride `layout` implies: its bytesPerLine, or the packed stride when that is 0. 0 for
+/// MJPEG (no rows).
+std::size_t strideOf(const PixelLayout& layout);
+/// Bytes a frame of `layout` needs at least (stride x rows, plus the chroma plane of NV12); 0 for
+/// MJPEG, whose frames vary in size.
+std::size_t minimumFrameBytes(const PixelLayout& layout);
+
+// Each conversion reads `data` as one image of the given layout and returns a new image that
+// owns its pixels (the capture buffer can be handed back to the driver at once). They return an
+// empty Mat when `data` is too short for the layout or the layout is odd (YUYV and NV12 need an
+// even width; NV12 an even height).
+
+/// YUYV 4:2:2 (Y0 U Y1 V), BT.601 limited range (16-235 luma), the encoding of UVC webcams and of
+/// vivid at SD sizes: Y=16 is black, Y=235 white.
+cv::Mat convertYuyv(std::span<const std::uint8_t> data, int width, int height,
+                    std::size_t bytesPerLine);
+/// NV12: a full-resolution Y plane, then a half-resolution interleaved U,V plane with the same
+/// stride, directly after the last Y row (V4L2's single-plane NV12). BT.601 limited range.
+cv::Mat convertNv12(std::span<const std::uint8_t> data, int width, int height,
+                    std::size_t bytesPerLine);
+/// RGB3 (bytes R,G,B) when `bgrOrder` is false, BGR3 (bytes B,G,R) when true.
+cv::Mat convertRgb24(std::span<const std::uint8_t> data, int width, int height,
+                     std::size_t bytesPerLine, bool bgrOrder);
+/// GREY: 8-bit luma, full range, copied into all three channels.
+cv::Mat convertGrey(std::span<const std::uint8_t> data, int width, int height,
+                    std::size_t bytesPerLine);
+/// MJPG: one JPEG image decoded with cv::imdecode (trailing bytes after the end-of-image marker
+/// are ignored, so a buffer whose bytesused is the whole buffer still decodes).
+cv::Mat convertMjpeg(std::span<const std::uint8_t> data);
+/// Z16: little-endian 16-bit depth in `unitsPerMetre` units per metre, to CV_32FC1 metres;
+/// 0 (no measurement) stays 0.
+cv::Mat convertZ16(std::span<const std::uint8_t> data, int width, int height,
+                   std::size_t bytesPerLine, double unitsPerMetre);
+
+/// The conversion for `layout.fourcc`: colour formats give BGR CV_8UC3, Z16 gives metres. Empty
+/// for other formats, short data, or a JPEG that does not decode.
+cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout,
+                double unitsPerMetre);
+
+} // namespace defocus::v4l2
