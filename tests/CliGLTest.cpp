@@ -105,8 +105,10 @@ class Interrupt : public Cli, public ::testing::WithParamInterface<int> {};
 
 TEST_P(Interrupt, VideoWrittenSoFarIsFinalisedAndPlayable)
 {
-    const fs::path clip = longClip("interrupt_clip", 200);
-    const fs::path out = test::scratchDir("interrupt_out") / "clip.mp4";
+    // Own folders per signal: CTest runs the two instances in parallel.
+    const std::string suffix = std::to_string(GetParam());
+    const fs::path clip = longClip("interrupt_clip_" + suffix, 200);
+    const fs::path out = test::scratchDir("interrupt_out_" + suffix) / "clip.mp4";
     const fs::path partial = out.parent_path() / "clip.partial.mp4";
     // Signal once a few frames are in the container.
     const ProgramRun run = runDefocus({(clip / "rgb").string(), "--depth", (clip / "depth").string(), "--depth-scale", "5000", "-o",
