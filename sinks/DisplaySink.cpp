@@ -353,7 +353,7 @@ void DisplaySink::saveScreenshot()
     while (std::filesystem::exists(file, ec));
     bool ok = false;
     try {
-        ok = cv::imwrite(file.string(), shown_);
+        ok = cv::imwrite(file.string(), shown_, {cv::IMWRITE_PNG_COMPRESSION, 9});
     } catch (const cv::Exception&) {
         ok = false;
     }

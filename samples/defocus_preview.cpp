@@ -1,0 +1,415 @@
+// defocus-preview: a live depth-of-field preview with autofocus, keyboard and mouse controls.
+//   defocus-preview /dev/video0 --depth depth.png      (webcam + one depth image, fixed camera)
+//   defocus-preview /dev/video0 --depth /dev/video2    (colour + Z16 depth camera)
+//   defocus-preview data/tum_fr1_rpy --loop            (a recorded clip, at its own pace)
+//   defocus-preview data/tum_fr1_rpy --no-window --loop --frames 300 --no-pace  (timing only)
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "filter/Autofocus.hpp"
+#include "filter/Pipeline.hpp"
+#include "filter/Settings.hpp"
+#include "filter/gl/EglContext.hpp"
+#include "samples/LiveLoop.hpp"
+#include "sinks/DisplaySink.hpp"
+#include "sources/FrameSource.hpp"
+
+namespace {
+
+using namespace defocus;
+
+std::atomic<bool> gStop{false};
+
+extern "C" void onSignal(int)
+{
+    gStop = true;
+}
+
+/// Exit codes: 0 done, 1 runtime failure (input, display, GL), 2 bad command line, 130 stopped.
+enum Exit { kOk = 0, kFailure = 1, kUsage = 2, kInterrupted = 130 };
+
+struct Options {
+    std::string input;
+    std::string depth;
+    std::optional<double> depthScale;
+    int width = 640;
+    int height = 480;
+    double cameraFps = 30.0;
+    std::string focus = "auto";
+    LensSettings lens;
+    std::string model = "thin-lens";
+    std::optional<double> nearM;
+    std::optional<double> farM;
+    QualitySettings quality;
+    std::string view = "composite";
+    AutofocusSettings autofocus;
+    std::optional<std::size_t> frames;
+    bool loop = false;
+    bool exitAtEnd = false;
+    bool noPace = false;
+    bool noWindow = false;
+    bool trace = false;
+    std::string screenshotDir = ".";
+    bool quiet = false;
+    bool verbose = false;
+};
+
+bool isVideoDevice(const std::string& path)
+{
+    return path.rfind("/dev/video", 0) == 0;
+}
+
+std::string modelName(CocModel model)
+{
+    return model == CocModel::ThinLens ? "thin-lens" : "focal-range";
+}
+
+int run(const Options& o)
+{
+    SourceOptions sourceOptions;
+    sourceOptions.input = o.input;
+    if (!o.depth.empty())
+        sourceOptions.depth = o.depth;
+    sourceOptions.depthScale = o.depthScale;
+    sourceOptions.width = o.width;
+    sourceOptions.height = o.height;
+    sourceOptions.fps = o.cameraFps;
+    std::unique_ptr<FrameSource> source = openSource(sourceOptions);
+    // Cameras never block the preview; clips never drop a frame.
+    const bool live = source->isLive() || isVideoDevice(o.input);
+    const double sourceFps = source->frameRate() > 0.0 ? source->frameRate() : 30.0;
+
+    LiveControls controls;
+    controls.lens = o.lens;
+    controls.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
+    parseView(o.view, controls.view); // checked by CLI11
+    controls.autofocus = o.focus == "auto";
+    Autofocus autofocus(o.autofocus);
+    if (!controls.autofocus)
+        autofocus.setFocus(o.lens.focusM);
+    // The focal range follows the focus, keeping the ratios given at the start.
+    const double rangeFocus = std::isfinite(autofocus.focusM()) ? autofocus.focusM() : 2.0;
+    controls.nearRatio = o.nearM.value_or(controls.nearRatio * rangeFocus) / rangeFocus;
+    controls.farRatio = o.farM.value_or(controls.farRatio * rangeFocus) / rangeFocus;
+
+    // The window before the GL context: a missing display is the likelier failure, and cheap.
+    std::unique_ptr<DisplaySink> display;
+    if (!o.noWindow)
+        display = std::make_unique<DisplaySink>(controls, DisplayOptions{"defocus-preview", o.screenshotDir});
+    auto context = gl::EglContext::create();
+    Pipeline pipeline;
+    if (!o.quiet)
+        spdlog::info("{} ({}) on {}; keys: {}", source->describe(), live ? "live: newest frame, drops counted"
+                                                                         : "recorded: every frame",
+                     context.info().glRenderer, kKeyHelp);
+
+    auto feed = std::make_unique<FrameFeed>(*source, live);
+    Pacer pacer(1.0 / sourceFps);
+    LiveStats stats;
+    std::optional<FedFrame> current;
+    std::vector<PassTime> gpu;
+    std::size_t framesShown = 0, pipelineFrames = 0, renders = 0;
+    double pipelineMs = 0.0;
+    double previousTimestamp = 0.0;
+    bool ended = false, endNoted = false, forceRender = false, captureClock = false;
+    std::uint64_t renderedRevision = std::numeric_limits<std::uint64_t>::max();
+    std::string lastIssues;
+    auto lastStep = LiveClock::now();
+    int exitCode = kOk;
+
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    try {
+        while (!controls.quit && !gStop) {
+            // 1. A new frame, unless paused or at the end.
+            bool fresh = false;
+            feed->setPaused(controls.paused);
+            const bool wantFrame = !ended && !controls.paused && (!o.frames || framesShown < *o.frames);
+            if (wantFrame) {
+                const auto readStart = LiveClock::now();
+                std::optional<FedFrame> fed = feed->next(std::chrono::milliseconds(20));
+                if (fed && !live) {
+                    // The latency of a clip frame starts when it is read, or when it falls due
+                    // if it had to wait for the clip's pace.
+                    const auto due = o.noPace ? readStart : pacer.wait(fed->frame.timestamp);
+                    fed->origin = std::max(readStart, due);
+                }
+                if (fed) {
+                    const double dt = frameInterval(previousTimestamp, fed->frame.timestamp, 1.0 / sourceFps);
+                    previousTimestamp = fed->frame.timestamp;
+                    if (controls.autofocus)
+                        autofocus.update(fed->frame.depth, dt);
+                    else
+                        autofocus.advance(dt);
+                    captureClock = captureClock || fed->fromCaptureClock;
+                    current = std::move(fed);
+                    fresh = true;
+                    lastStep = LiveClock::now();
+                } else if (feed->ended()) {
+                    if (o.loop && !live && framesShown > 0) {
+                        feed.reset();
+                        source = openSource(sourceOptions);
+                        feed = std::make_unique<FrameFeed>(*source, live);
+                        previousTimestamp = 0.0;
+                        continue;
+                    }
+                    ended = true;
+                }
+            }
+            if (!ended && o.frames && framesShown >= *o.frames)
+                ended = true;
+            if (ended && !endNoted) {
+                endNoted = true;
+                forceRender = true;
+                feed->stop(); // a camera past --frames stops capturing (and dropping)
+                if (!o.quiet)
+                    spdlog::info("end of stream after {} frames{}", framesShown,
+                                 display && !o.exitAtEnd ? "; holding the last frame (q quits)" : "");
+                if (!display || o.exitAtEnd || !current)
+                    break;
+            }
+
+            // 2. Requests from the window, and the focus of a held frame.
+            if (current && controls.tap) {
+                const cv::Mat& color = current->frame.color;
+                autofocus.tap(*controls.tap, static_cast<double>(color.cols) / color.rows);
+                if (!autofocus.retarget(current->frame.depth))
+                    spdlog::warn("tap to focus: no valid depth there; the focus stays at {:.2f} m", autofocus.targetM());
+                else
+                    spdlog::info("tap to focus: target {:.3f} m", autofocus.targetM());
+            }
+            controls.tap.reset();
+            if (current && controls.recentre) {
+                autofocus.recentre();
+                autofocus.retarget(current->frame.depth);
+            }
+            controls.recentre = false;
+            bool animating = false;
+            const auto now = LiveClock::now();
+            if (current && !fresh) {
+                // A held frame (paused, at the end, or between live frames): the spring runs on
+                // wall-clock time so that a tap still glides to its target.
+                if (controls.autofocus && controls.revision != renderedRevision)
+                    autofocus.retarget(current->frame.depth);
+                if (!autofocus.settled()) {
+                    autofocus.advance(std::chrono::duration<double>(now - lastStep).count());
+                    animating = true;
+                }
+            }
+            lastStep = now;
+
+            // 3. Render and show when anything changed.
+            const bool render = current && (fresh || animating || forceRender || controls.revision != renderedRevision);
+            if (!render) {
+                if (display)
+                    display->poll(live && !controls.paused ? 1 : 15);
+                continue;
+            }
+            forceRender = false;
+            std::vector<SettingIssue> issues;
+            const LensSettings lens = lensFor(controls, autofocus.focusM(), &issues);
+            std::string issueText;
+            for (const auto& issue : issues)
+                issueText += (issueText.empty() ? "" : "; ") + issue.message;
+            if (issueText != lastIssues && !issueText.empty())
+                spdlog::warn("clamped: {}", issueText);
+            lastIssues = issueText;
+
+            pipeline.process(current->frame, lens, o.quality);
+            const cv::Mat image = pipeline.read(controls.view, Encoding::Srgb8);
+            const FrameTimings& timings = pipeline.timings();
+            if (!timings.gpu.empty())
+                gpu = timings.gpu;
+            renderedRevision = controls.revision;
+            ++renders;
+            if (display) {
+                HudStatus status;
+                status.focusM = autofocus.focusM();
+                status.targetM = autofocus.targetM();
+                status.autofocus = controls.autofocus;
+                status.tapped = autofocus.tapped();
+                status.focusWindow = autofocus.window();
+                status.lens = lens;
+                status.view = controls.view;
+                status.fps = stats.recentFps();
+                status.latencyMs = stats.recentLatencyMs();
+                status.dropped = feed->dropped();
+                status.frameIndex = current->frame.index;
+                status.paused = controls.paused;
+                status.live = live;
+                status.ended = ended;
+                status.timings = timings;
+                status.gpu = gpu;
+                if (!issueText.empty()) {
+                    status.message = "clamped: " + issueText;
+                    status.warning = true;
+                }
+                display->setFocusForKeys(autofocus.focusM());
+                display->setStatus(status, controls.tileMap ? &pipeline.analysis() : nullptr);
+                display->write(image);
+            }
+            if (fresh) {
+                stats.frameShown(current->origin, LiveClock::now());
+                ++framesShown;
+                pipelineMs += timings.totalMs;
+                ++pipelineFrames;
+            }
+            if (o.trace) {
+                std::printf("shown frame=%zu new=%d view=%s focus=%.4f target=%.4f af=%d paused=%d ended=%d rev=%llu\n",
+                            current->frame.index, fresh ? 1 : 0, std::string(viewName(controls.view)).c_str(),
+                            autofocus.focusM(), autofocus.targetM(), controls.autofocus ? 1 : 0,
+                            controls.paused ? 1 : 0, ended ? 1 : 0,
+                            static_cast<unsigned long long>(controls.revision));
+                std::fflush(stdout);
+            }
+        }
+    } catch (const std::exception& error) {
+        spdlog::error("frame {}: {}", framesShown, error.what());
+        exitCode = kFailure;
+    }
+    feed->stop();
+    if (display)
+        display->finish();
+    if (gStop) {
+        spdlog::warn("stopped by signal after {} frames", framesShown);
+        if (exitCode == kOk)
+            exitCode = kInterrupted;
+    }
+    if (exitCode == kOk && framesShown == 0) {
+        spdlog::error("{} gave no frames", o.input);
+        return kFailure;
+    }
+
+    const char* origin = captureClock ? "capture timestamp" : "read";
+    const char* end = display ? "display" : "frame ready (no window)";
+    std::printf("defocus-preview: %zu frames shown, %zu dropped, %zu renders; %.1f fps; latency %s -> %s: p50 %.1f ms, "
+                "p95 %.1f ms, max %.1f ms; pipeline %.1f ms/frame\n",
+                framesShown, feed->dropped(), renders, stats.fps(), origin, end, stats.latencyPercentileMs(0.5),
+                stats.latencyPercentileMs(0.95), stats.latencyPercentileMs(1.0),
+                pipelineFrames ? pipelineMs / static_cast<double>(pipelineFrames) : 0.0);
+    const LensSettings lens = lensFor(controls, autofocus.focusM());
+    std::printf("defocus-preview: final focus %.3f m (%s, target %.3f m), f/%.2f, max CoC %.1f px, %s, view %s\n",
+                autofocus.focusM(), controls.autofocus ? "auto" : "manual", autofocus.targetM(), lens.fNumber,
+                lens.maxCocPx, modelName(lens.model).c_str(), std::string(viewName(controls.view)).c_str());
+    std::fflush(stdout);
+    return exitCode;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    Options o;
+    CLI::App app{"defocus-preview: live depth-of-field preview with autofocus (McIntosh et al. 2012 hexagonal "
+                 "bokeh).\nINPUT is a camera (/dev/videoN), a video file, a TUM RGB-D folder, a folder of colour "
+                 "images or one image; --depth gives its depth (a file, a folder, a TUM depth.txt or a Z16 camera "
+                 "/dev/videoN).\nKeys: " +
+                 std::string(kKeyHelp)};
+    app.set_version_flag("--version", "defocus-preview 0.1.0");
+    app.add_option("input", o.input, "Colour input: /dev/videoN, video file, TUM folder, image folder or image")
+        ->required();
+    app.add_option("--depth", o.depth, "Depth for INPUT: one image (fixed camera), a folder, depth.txt, or /dev/videoN");
+    app.add_option("--depth-scale", o.depthScale,
+                   "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--width", o.width, "Camera capture width, pixels")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--height", o.height, "Camera capture height, pixels")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--camera-fps", o.cameraFps, "Camera frame rate to ask for, Hz")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--frames", o.frames, "Stop reading after this many frames")->check(CLI::PositiveNumber);
+    app.add_option("--focus", o.focus,
+                   "'auto' (autofocus on; click to focus) or a distance in metres / 'inf' (autofocus off)")
+        ->capture_default_str();
+    app.add_option("--f-number", o.lens.fNumber, "Aperture as an f-number N, 0.7..64 (+/- keys: 1/3 stop)")
+        ->capture_default_str();
+    app.add_option("--focal-length", o.lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
+    app.add_option("--sensor-width", o.lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
+        ->capture_default_str();
+    app.add_option("--max-coc", o.lens.maxCocPx, "Largest blur diameter, pixels, 0..512 ([ ] keys)")->capture_default_str();
+    app.add_option("--coc-model", o.model, "thin-lens or focal-range (m key)")
+        ->check(CLI::IsMember({"thin-lens", "focal-range"}))
+        ->capture_default_str();
+    app.add_option("--near", o.nearM,
+                   "focal-range model: near limit in metres at the starting focus (2 m with auto); it then follows "
+                   "the focus in proportion [default: half the focus]");
+    app.add_option("--far", o.farM, "focal-range model: far limit, likewise [default: 3 x the focus]");
+    app.add_option("--samples", o.quality.samples, "Taps per directional blur pass, 2..64")->capture_default_str();
+    std::vector<std::string> views;
+    for (const View v : kAllViews)
+        views.emplace_back(viewName(v));
+    app.add_option("--view", o.view, "View at the start: " + fmt::format("{}", fmt::join(views, ", ")))
+        ->check(CLI::IsMember(views))
+        ->capture_default_str();
+    app.add_option("--tau", o.autofocus.timeConstantS, "Autofocus time constant, seconds (critically damped), >= 0")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    app.add_option("--af-window", o.autofocus.windowFraction, "Autofocus centre window, fraction of each axis, (0, 1]")
+        ->check(CLI::Range(1e-3, 1.0))
+        ->capture_default_str();
+    app.add_option("--af-dead-band", o.autofocus.deadBandDioptres,
+                   "Autofocus dead band, dioptres: smaller changes of the measured depth are ignored")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    app.add_flag("--loop", o.loop, "Play a recorded clip again and again");
+    app.add_flag("--exit-at-end", o.exitAtEnd, "Quit at the end of a clip (or after --frames) instead of holding");
+    app.add_flag("--no-pace", o.noPace, "Play a recorded clip as fast as it can be processed, not at its own rate");
+    app.add_flag("--no-window", o.noWindow, "No window: process and print the figures (for timing; exits at the end)");
+    app.add_flag("--trace", o.trace, "Print one line per picture shown (view, focus, state) on stdout, for tests");
+    app.add_option("--screenshot-dir", o.screenshotDir, "Where the s key writes defocus-preview-NNNN.png")
+        ->capture_default_str();
+    app.add_flag("-q,--quiet", o.quiet, "Only the summary and errors");
+    app.add_flag("-v,--verbose", o.verbose, "Debug logging");
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    spdlog::set_pattern("%^defocus-preview: %l:%$ %v");
+    spdlog::set_level(o.verbose ? spdlog::level::debug : o.quiet ? spdlog::level::warn : spdlog::level::info);
+
+    try {
+        if (o.focus == "inf" || o.focus == "infinity") {
+            o.lens.focusM = std::numeric_limits<double>::infinity();
+        } else if (o.focus != "auto") {
+            try {
+                std::size_t used = 0;
+                o.lens.focusM = std::stod(o.focus, &used);
+                if (used != o.focus.size())
+                    throw std::invalid_argument(o.focus);
+            } catch (const std::logic_error&) {
+                spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);
+                return kUsage;
+            }
+        }
+        // The command line is checked strictly, like defocus's; keys later clamp with a warning.
+        LensSettings lensToCheck = o.lens;
+        if (o.focus == "auto")
+            lensToCheck.focusM = std::max(lensToCheck.focusM, lensToCheck.focalLengthMm * 2e-3);
+        auto issues = validate(lensToCheck);
+        const auto qualityIssues = validate(o.quality);
+        issues.insert(issues.end(), qualityIssues.begin(), qualityIssues.end());
+        for (const auto& issue : issues)
+            spdlog::error("{}", issue.message);
+        if (!issues.empty())
+            return kUsage;
+        return run(o);
+    } catch (const std::exception& error) {
+        spdlog::error("{}", error.what());
+        return kFailure;
+    }
+}
