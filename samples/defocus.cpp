@@ -15,9 +15,12 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
+#include "filter/methods/Presets.hpp"
 #include "filter/Pipeline.hpp"
 #include "filter/Settings.hpp"
 #include "filter/Views.hpp"
@@ -49,6 +52,8 @@ struct Options {
     std::string focus = "auto";
     LensSettings lens;
     QualitySettings quality;
+    std::string qualityPreset = std::string(kDefaultPreset);
+    bool halfResolution = false; ///< from a preset: blur at half size, upscale the result
     std::string model = "thin-lens";
     std::string precision = "16f";
     std::string view = "composite";
@@ -147,6 +152,19 @@ private:
     std::vector<nlohmann::json> frames_;
 };
 
+/// Half-resolution frame for presets that blur at half size, as the accuracy benchmark measured
+/// them (filter/methods/Method.hpp): linear colour area-averaged, depth by nearest neighbour.
+Frame halfFrame(const Frame& frame)
+{
+    Frame half = frame;
+    const cv::Size size((frame.color.cols + 1) / 2, (frame.color.rows + 1) / 2);
+    const cv::Mat linear = frame.color.type() == CV_8UC3 ? decodeSrgb(frame.color) : frame.color;
+    cv::resize(linear, half.color, size, 0, 0, cv::INTER_AREA);
+    if (!frame.depth.empty())
+        cv::resize(frame.depth, half.depth, size, 0, 0, cv::INTER_NEAREST);
+    return half;
+}
+
 int run(const Options& options)
 {
     SourceOptions sourceOptions{options.input, std::nullopt, options.depthScale};
@@ -197,7 +215,16 @@ int run(const Options& options)
                 if (const auto issues = validate(lens); !issues.empty())
                     throw std::runtime_error(fmt::format("automatic focus: {}", issues.front().message));
             }
-            cv::Mat image = pipeline.run(*frame, lens, options.quality, view, encoding);
+            cv::Mat image;
+            if (options.halfResolution) {
+                LensSettings halfLens = lens;
+                halfLens.maxCocPx *= 0.5;
+                cv::Mat linear = pipeline.run(halfFrame(*frame), halfLens, options.quality, view, Encoding::Linear32F);
+                cv::resize(linear, linear, frame->color.size(), 0, 0, cv::INTER_LINEAR);
+                image = encoding == Encoding::Linear32F ? linear : encodeSrgb(linear);
+            } else {
+                image = pipeline.run(*frame, lens, options.quality, view, encoding);
+            }
             if (!options.contactSheet.empty() && frame->index == options.contactFrame) {
                 std::vector<std::pair<std::string, cv::Mat>> tiles;
                 int number = 1;
@@ -287,10 +314,14 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--far", o.lens.farLimitM, "focal-range model: metres where far blur reaches --max-coc")
         ->capture_default_str();
-    app.add_option("--samples", o.quality.samples, "Taps per directional blur pass, 2..64")->capture_default_str();
-    app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f")
-        ->check(CLI::IsMember({"16f", "32f"}))
+    app.add_option("--quality", o.qualityPreset,
+                   "Preset from the accuracy benchmark (docs/accuracy.md): fast (12 taps at half size), balanced "
+                   "(16 taps), high (48 taps); --samples and --precision override it")
+        ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
+    app.add_option("--samples", o.quality.samples, "Taps per directional blur pass, 2..64 [default: from --quality]");
+    app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
+        ->check(CLI::IsMember({"16f", "32f"}));
     std::vector<std::string> views;
     for (const View v : kAllViews)
         views.emplace_back(viewName(v));
@@ -325,6 +356,14 @@ int main(int argc, char** argv)
         if (o.input.empty() || o.output.empty()) {
             spdlog::error("INPUT and -o OUTPUT are required (see --help)");
             return kUsage;
+        }
+        {
+            const QualitySettings fromPreset = presetSettings(o.qualityPreset);
+            if (app.count("--samples") == 0)
+                o.quality.samples = fromPreset.samples;
+            if (app.count("--precision") == 0)
+                o.precision = fromPreset.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
+            o.halfResolution = preset(o.qualityPreset).settings.resolution == Resolution::Half;
         }
         o.quality.adaptive = !alwaysOn;
         o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
