@@ -54,6 +54,24 @@ void ensureTexture(gl::Texture& texture, GLenum format, cv::Size size, const cha
         texture = gl::Texture(format, size.width, size.height, name);
 }
 
+/// The range of valid depths in `depth` (any size); `lo`/`hi` unchanged when there is none.
+void validDepthRange(const cv::Mat& depth, float& lo, float& hi)
+{
+    float low = std::numeric_limits<float>::max(), high = std::numeric_limits<float>::lowest();
+    for (int y = 0; y < depth.rows; ++y) {
+        const float* z = depth.ptr<float>(y);
+        for (int x = 0; x < depth.cols; ++x)
+            if (isValidDepth(z[x])) {
+                low = std::min(low, z[x]);
+                high = std::max(high, z[x]);
+            }
+    }
+    if (low <= high) {
+        lo = low;
+        hi = high;
+    }
+}
+
 } // namespace
 
 struct Pipeline::Impl {
@@ -87,10 +105,14 @@ struct Pipeline::Impl {
     SceneAnalysis analysis;
     FramePlan plan;
     bool rendered = false;
+    bool depthPrepared = false; ///< the all-in-focus exit skips hole filling until a view needs it
+    cv::Mat depthInput;
+    float fallbackDepth = 1.0f;
     std::size_t frameIndex = 0;
     std::size_t gpuFrameIndex = 0; ///< frame whose GPU scopes are pending in the timer
 
     void render();
+    void prepareDepthAndPlan();
 
     explicit Impl(bool timers) : timer(timers) {}
 
@@ -141,28 +163,57 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     p.frameStart = Clock::now();
     p.size = frame.color.size();
 
-    // Depth: colour-sized, holes filled. With no depth at all, everything sits on the focus plane.
     auto start = Clock::now();
-    const float fallback = std::isinf(lens.focusM) ? 1e6f : static_cast<float>(lens.focusM);
-    p.prepared = prepareDepth(frame.depth, p.size, fallback);
-    p.timings.depthPrepMs = msSince(start);
-
-    start = Clock::now();
     p.color = frame.color;
+    p.depthInput = frame.depth;
     p.quality = quality;
     p.coefficients = cocCoefficients(lens, p.size.width);
     p.maxCocPx = p.coefficients.maxCocPx;
     p.frameIndex = frame.index;
-    p.analysis = analyseScene(p.prepared.metres, frame.color, p.coefficients, p.prepared.invalidFraction);
-    p.plan = makePlan(p.analysis, quality.nearField);
-    p.timings.analysisMs = msSince(start);
+    p.fallbackDepth = std::isinf(lens.focusM) ? 1e6f : static_cast<float>(lens.focusM);
     p.rendered = false;
+    p.depthPrepared = false;
+
+    // All in focus? Hole filling only averages valid depths, so the valid range bounds the
+    // filled map, and CoC is monotonic in depth: the CoC of the two ends decides, before any
+    // hole filling, analysis or upload.
+    if (quality.adaptive) {
+        float lo = p.fallbackDepth, hi = p.fallbackDepth;
+        validDepthRange(frame.depth, lo, hi);
+        const float c0 = cocPixels(p.coefficients, lo), c1 = cocPixels(p.coefficients, hi);
+        if (std::max(std::abs(c0), std::abs(c1)) < 0.5f) {
+            p.analysis = {};
+            p.analysis.minCoc = std::min(c0, c1);
+            p.analysis.maxCoc = std::max(c0, c1);
+            p.plan = {};
+            p.plan.allInFocus = true;
+            p.timings.analysisMs = msSince(start);
+            return;
+        }
+    }
+    p.prepareDepthAndPlan();
+    p.timings.analysisMs = msSince(start) - p.timings.depthPrepMs;
     if (!(quality.adaptive && p.plan.allInFocus))
         p.render();
 }
 
+void Pipeline::Impl::prepareDepthAndPlan()
+{
+    // Depth: colour-sized, holes filled. With no depth at all, everything sits on the focus plane.
+    const auto start = Clock::now();
+    prepared = prepareDepth(depthInput, size, fallbackDepth);
+    timings.depthPrepMs = msSince(start);
+    depthPrepared = true;
+    analysis = analyseScene(prepared.metres, color, coefficients, prepared.invalidFraction);
+    const bool allInFocus = plan.allInFocus && quality.adaptive;
+    plan = makePlan(analysis, quality.nearField);
+    plan.allInFocus = plan.allInFocus || allInFocus;
+}
+
 void Pipeline::Impl::render()
 {
+    if (!depthPrepared)
+        prepareDepthAndPlan();
     auto start = Clock::now();
     const bool srgbInput = color.type() == CV_8UC3;
     ensureTexture(depth, GL_R32F, size, "filled depth");
@@ -183,7 +234,8 @@ void Pipeline::Impl::render()
     // Tiles in focus are copied, not blurred, when enough of them are: a thousand small quads
     // cost the rasteriser more than one full-screen triangle (on llvmpipe, drawing 1181 of 1200
     // tiles took 25 % longer than the whole frame), so a few copy tiles are not worth it.
-    const bool useTiles = quality.adaptive && plan.copyTiles.size() * 4 >= plan.copyTiles.size() + plan.blurTiles.size();
+    const bool useTiles = quality.adaptive && !plan.copyTiles.empty() &&
+                          plan.copyTiles.size() * 4 >= plan.copyTiles.size() + plan.blurTiles.size();
     if (useTiles) {
         blurTiles.set(plan.blurTiles, size, SceneAnalysis::kTileSize);
         copyTiles.set(plan.copyTiles, size, SceneAnalysis::kTileSize);
@@ -317,11 +369,15 @@ cv::Mat Pipeline::readTarget(View view) const
 
 const cv::Mat& Pipeline::filledDepth() const
 {
+    if (!impl_->depthPrepared)
+        impl_->prepareDepthAndPlan();
     return impl_->prepared.metres;
 }
 
 double Pipeline::invalidDepthFraction() const
 {
+    if (!impl_->depthPrepared)
+        impl_->prepareDepthAndPlan();
     return impl_->prepared.invalidFraction;
 }
 

@@ -113,6 +113,8 @@ std::string FramePlan::explain(const SceneAnalysis& analysis) const
                                   : fmt::format("coc, blur x3 on {}/{} tiles (copy {}), composite; CoC {:+.1f}..{:+.1f} px",
                                                 blurTiles.size(), total, copyTiles.size(), analysis.minCoc,
                                                 analysis.maxCoc);
+    if (allInFocus)
+        return text + " (hole filling and analysis skipped)";
     text += holeFill ? fmt::format("; hole fill on ({:.1f} % invalid)", 100.0 * analysis.invalidDepthFraction)
                      : "; hole fill off (no holes)";
     text += nearField ? fmt::format("; near field on {} tiles", nearTiles.size())
