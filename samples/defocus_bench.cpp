@@ -1,1 +1,614 @@
-int main() { return 0; }
+// defocus-bench: speed of the McIntosh pipeline, ms per pass and per frame, on the bundled TUM clip
+// resized to each frame size, for a defocused and an all-in-focus scene. A benchmark, not a test.
+//   defocus-bench                                    (run from the repository root)
+//   defocus-bench --sizes 640x480 --runs 30 --json out/bench.json
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+#include "filter/DepthPrep.hpp"
+#include "filter/Lens.hpp"
+#include "filter/Pipeline.hpp"
+#include "filter/Settings.hpp"
+#include "filter/gl/EglContext.hpp"
+#include "sources/FrameSource.hpp"
+#include "samples/BenchTiming.hpp"
+
+#include <unistd.h>
+
+namespace {
+
+using namespace defocus;
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+/// Exit codes: 0 done, 1 runtime failure (data, GL, output), 2 bad command line.
+enum Exit { kOk = 0, kFailure = 1, kUsage = 2 };
+
+struct Options {
+    std::string data = "data/tum_fr1_rpy";
+    std::vector<std::string> sizes = {"640x480", "1920x1080"};
+    int runs = 15;
+    int warmup = 3;
+    int samples = QualitySettings{}.samples;
+    std::string precision = "16f";
+    double focusM = 1.0;
+    double fNumber = 2.0;
+    double focalLengthMm = 50.0;
+    double maxCocAt640 = 32.0;
+    bool noTimers = false;
+    bool noAdaptive = false;
+    std::string json;
+};
+
+/// One measured quantity over the runs of one scene, in milliseconds.
+struct Series {
+    std::string key;   ///< JSON name
+    std::string label; ///< table row
+    std::vector<double> ms;
+};
+
+/// All series of one (size, scene), in table order: GPU passes as the pipeline reports them,
+/// their sum, then the CPU-side wall times.
+struct SceneResult {
+    std::string scene;
+    std::vector<Series> gpu;
+    std::vector<Series> wall;
+    double othersCpuShare = -1.0; ///< CPU share other processes used during the runs; -1 unknown
+};
+
+/// How the lens spreads blur over the defocused scene, so the figures can be read against it.
+struct CocSpread {
+    double sharpShare = 0.0;   ///< |CoC| < 0.5 px
+    double nearShare = 0.0;    ///< CoC <= -0.5 px (in front of the focus)
+    double farShare = 0.0;     ///< CoC >= 0.5 px (behind it)
+    double clampedShare = 0.0; ///< |CoC| at max-coc
+    double medianAbsPx = 0.0;
+    double p90AbsPx = 0.0;
+};
+
+/// q-quantile with linear interpolation between order statistics (numpy's default).
+double quantile(std::vector<double> values, double q)
+{
+    if (values.empty())
+        return std::nan("");
+    std::sort(values.begin(), values.end());
+    const double position = q * static_cast<double>(values.size() - 1);
+    const auto below = static_cast<std::size_t>(std::floor(position));
+    const std::size_t above = std::min(below + 1, values.size() - 1);
+    const double t = position - static_cast<double>(below);
+    return values[below] + (values[above] - values[below]) * t;
+}
+
+double median(const std::vector<double>& values)
+{
+    return quantile(values, 0.5);
+}
+
+double p90(const std::vector<double>& values)
+{
+    return quantile(values, 0.9);
+}
+
+cv::Size parseSize(const std::string& text)
+{
+    int width = 0, height = 0;
+    char separator = 0;
+    char rest = 0;
+    if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &separator, &height, &rest) != 3 ||
+        (separator != 'x' && separator != 'X') || width < 16 || height < 16 || width > 8192 || height > 8192)
+        throw CLI::ValidationError("--sizes", fmt::format("'{}' is not WIDTHxHEIGHT with sides in [16, 8192]", text));
+    return {width, height};
+}
+
+std::string utcNow()
+{
+    const std::time_t now = std::time(nullptr);
+    std::tm utc{};
+    gmtime_r(&now, &utc);
+    char text[32];
+    std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+    return text;
+}
+
+std::string cpuModel()
+{
+    std::ifstream cpuinfo("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(cpuinfo, line))
+        if (line.rfind("model name", 0) == 0)
+            if (const auto colon = line.find(':'); colon != std::string::npos)
+                return line.substr(line.find_first_not_of(' ', colon + 1));
+    return "unknown";
+}
+
+/// The 1-minute load average, to tell a quiet machine from a busy one; -1 when unknown.
+double loadAverage()
+{
+    std::ifstream file("/proc/loadavg");
+    double load = -1.0;
+    file >> load;
+    return file ? load : -1.0;
+}
+
+/// CPU seconds spent so far: by the whole machine (all cores, from /proc/stat) and by this
+/// process (getrusage). The difference over a measurement is what other processes took.
+struct CpuClock {
+    double machineBusyS = -1.0;
+    double machineTotalS = -1.0;
+    double selfS = 0.0;
+
+    static CpuClock now()
+    {
+        CpuClock clock;
+        rusage usage{};
+        getrusage(RUSAGE_SELF, &usage);
+        const auto seconds = [](const timeval& t) {
+            return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+        };
+        clock.selfS = seconds(usage.ru_utime) + seconds(usage.ru_stime);
+        std::ifstream stat("/proc/stat");
+        std::string cpu;
+        double user = 0, nice = 0, system = 0, idle = 0, iowait = 0, irq = 0, softirq = 0, steal = 0;
+        if (stat >> cpu >> user >> nice >> system >> idle >> iowait >> irq >> softirq >> steal && cpu == "cpu") {
+            const double tick = static_cast<double>(sysconf(_SC_CLK_TCK));
+            clock.machineBusyS = (user + nice + system + irq + softirq + steal) / tick;
+            clock.machineTotalS = clock.machineBusyS + (idle + iowait) / tick;
+        }
+        return clock;
+    }
+
+    /// Share of all CPU time between `start` and this clock that went to other processes.
+    double othersShareSince(const CpuClock& start) const
+    {
+        const double total = machineTotalS - start.machineTotalS;
+        if (start.machineTotalS < 0 || machineTotalS < 0 || total <= 0)
+            return -1.0;
+        const double others = (machineBusyS - start.machineBusyS) - (selfS - start.selfS);
+        return std::clamp(others / total, 0.0, 1.0);
+    }
+};
+
+/// Reads every frame of the clip once; the runs then cycle through them.
+std::vector<Frame> loadClip(const fs::path& folder)
+{
+    std::error_code ec;
+    if (!fs::is_directory(folder, ec))
+        throw std::runtime_error(fmt::format(
+            "data folder '{}' not found (looked from '{}'); run from the repository root or pass --data DIR",
+            folder.string(), fs::current_path(ec).string()));
+    auto source = openSource(SourceOptions{folder, std::nullopt, std::nullopt});
+    std::vector<Frame> frames;
+    while (auto frame = source->next()) {
+        if (frame->depth.empty())
+            throw std::runtime_error(fmt::format("{}: frame {} has no depth", folder.string(), frame->name));
+        frames.push_back(std::move(*frame));
+    }
+    if (frames.empty())
+        throw std::runtime_error(fmt::format("{} gave no frames", source->describe()));
+    return frames;
+}
+
+/// The clip at `size`: colour by area averaging (shrinking) or bilinear (enlarging), depth by
+/// nearest neighbour so no depth is invented across edges and holes stay holes.
+std::vector<Frame> resizeClip(const std::vector<Frame>& clip, cv::Size size)
+{
+    std::vector<Frame> frames;
+    for (const Frame& original : clip) {
+        Frame frame = original;
+        if (original.color.size() != size) {
+            const bool shrinking = size.area() < original.color.size().area();
+            cv::resize(original.color, frame.color, size, 0, 0, shrinking ? cv::INTER_AREA : cv::INTER_LINEAR);
+        }
+        if (original.depth.size() != size)
+            cv::resize(original.depth, frame.depth, size, 0, 0, cv::INTER_NEAREST);
+        frames.push_back(std::move(frame));
+    }
+    return frames;
+}
+
+/// The same colour, every depth on the focus plane: the cost of a frame with nothing to blur.
+std::vector<Frame> inFocusClip(const std::vector<Frame>& clip, float focusM)
+{
+    std::vector<Frame> frames = clip;
+    for (Frame& frame : frames)
+        frame.depth = cv::Mat(frame.color.size(), CV_32FC1, cv::Scalar(focusM));
+    return frames;
+}
+
+CocSpread cocSpread(const std::vector<Frame>& frames, const LensSettings& lens)
+{
+    std::vector<double> absCoc;
+    std::size_t near = 0, far = 0, clamped = 0;
+    for (const Frame& frame : frames) {
+        const CocCoefficients k = cocCoefficients(lens, frame.color.cols);
+        const PreparedDepth depth = prepareDepth(frame.depth, frame.color.size(), static_cast<float>(lens.focusM));
+        for (int y = 0; y < depth.metres.rows; ++y) {
+            const float* row = depth.metres.ptr<float>(y);
+            for (int x = 0; x < depth.metres.cols; ++x) {
+                const float c = cocPixels(k, row[x]);
+                near += c <= -0.5f;
+                far += c >= 0.5f;
+                clamped += std::abs(c) >= k.maxCocPx;
+                absCoc.push_back(std::abs(c));
+            }
+        }
+    }
+    const auto share = [&](std::size_t count) {
+        return static_cast<double>(count) / static_cast<double>(absCoc.size());
+    };
+    CocSpread spread;
+    spread.nearShare = share(near);
+    spread.farShare = share(far);
+    spread.sharpShare = 1.0 - spread.nearShare - spread.farShare;
+    spread.clampedShare = share(clamped);
+    const auto middle = absCoc.begin() + static_cast<std::ptrdiff_t>(absCoc.size() / 2);
+    std::nth_element(absCoc.begin(), middle, absCoc.end());
+    spread.medianAbsPx = *middle;
+    const auto top = absCoc.begin() + static_cast<std::ptrdiff_t>(absCoc.size() * 9 / 10);
+    std::nth_element(absCoc.begin(), top, absCoc.end());
+    spread.p90AbsPx = *top;
+    return spread;
+}
+
+Series& seriesNamed(std::vector<Series>& all, const std::string& key, const std::string& label)
+{
+    for (Series& series : all)
+        if (series.key == key)
+            return series;
+    all.push_back({key, label, {}});
+    return all.back();
+}
+
+/// Runs `frames` (cycled) through the pipeline: `options.warmup` frames unmeasured, then
+/// `options.runs` measured ones. GPU timer results arrive one frame late, tagged with the index
+/// of the frame they belong to, so every frame gets a unique index and one extra frame at the
+/// end delivers the GPU times of the last measured one.
+SceneResult measure(Pipeline& pipeline, std::size_t& counter, const std::string& scene,
+                    const std::vector<Frame>& frames, const LensSettings& lens, const QualitySettings& quality,
+                    const Options& options)
+{
+    const auto runFrame = [&](int i) {
+        Frame frame = frames[static_cast<std::size_t>(i) % frames.size()];
+        frame.index = counter++;
+        pipeline.run(frame, lens, quality);
+        return frame.index;
+    };
+    for (int i = 0; i < options.warmup; ++i)
+        runFrame(i);
+
+    SceneResult result{scene, {}, {}};
+    std::vector<double> gpuSum, depthPrep, analysis, upload, render, readback, total;
+    const std::size_t firstMeasured = counter;
+    const CpuClock cpuStart = CpuClock::now();
+    const auto takeGpu = [&](const FrameTimings& t) {
+        if (t.gpu.empty() || t.gpuFrame < firstMeasured)
+            return;
+        double sum = 0.0;
+        for (const PassTime& pass : t.gpu) {
+            seriesNamed(result.gpu, pass.name, "GPU " + pass.name).ms.push_back(pass.ms);
+            sum += pass.ms;
+        }
+        gpuSum.push_back(sum);
+    };
+    for (int i = 0; i < options.runs; ++i) {
+        runFrame(options.warmup + i);
+        const FrameTimings& t = pipeline.timings();
+        takeGpu(t);
+        depthPrep.push_back(t.depthPrepMs);
+        analysis.push_back(t.analysisMs);
+        upload.push_back(t.uploadMs);
+        render.push_back(t.renderMs);
+        readback.push_back(t.readbackMs);
+        total.push_back(t.totalMs);
+    }
+    result.othersCpuShare = CpuClock::now().othersShareSince(cpuStart);
+    runFrame(options.warmup + options.runs);
+    takeGpu(pipeline.timings());
+
+    if (!gpuSum.empty())
+        result.gpu.push_back({"sum", "GPU sum of passes", gpuSum});
+    result.wall = {{"depthPrep", "depth prep (CPU)", depthPrep},
+                   {"analysis", "scene analysis (CPU)", analysis},
+                   {"upload", "upload (wall)", upload},
+                   {"renderSubmit", "render submit (wall)", render},
+                   {"readback", "readback (wall)", readback},
+                   {"total", "total per frame (wall)", total}};
+    return result;
+}
+
+/// Rows of both scenes side by side: label, then median and p90 of each scene.
+void printTable(const std::vector<SceneResult>& scenes)
+{
+    std::string header = fmt::format("{:<26}", "ms");
+    std::string subheader = fmt::format("{:<26}", "");
+    for (const SceneResult& scene : scenes) {
+        header += fmt::format("{:>20}", scene.scene);
+        subheader += fmt::format("{:>10}{:>10}", "median", "p90");
+    }
+    fmt::print("{}\n{}\n", header, subheader);
+
+    const auto row = [&](const std::string& label, const auto& pick) {
+        std::string line = fmt::format("{:<26}", label);
+        for (const SceneResult& scene : scenes) {
+            const Series* series = pick(scene);
+            if (series && !series->ms.empty())
+                line += fmt::format("{:>10.2f}{:>10.2f}", median(series->ms), p90(series->ms));
+            else
+                line += fmt::format("{:>10}{:>10}", "n/a", "n/a");
+        }
+        fmt::print("{}\n", line);
+    };
+    std::vector<std::pair<std::string, std::string>> gpuRows; // key, label, in first-seen order
+    for (const SceneResult& scene : scenes)
+        for (const Series& series : scene.gpu)
+            if (std::none_of(gpuRows.begin(), gpuRows.end(), [&](const auto& r) { return r.first == series.key; }))
+                gpuRows.emplace_back(series.key, series.label);
+    for (const auto& [key, label] : gpuRows)
+        row(label, [&key](const SceneResult& scene) -> const Series* {
+            for (const Series& series : scene.gpu)
+                if (series.key == key)
+                    return &series;
+            return nullptr;
+        });
+    for (std::size_t i = 0; i < scenes.front().wall.size(); ++i)
+        row(scenes.front().wall[i].label,
+            [i](const SceneResult& scene) -> const Series* { return &scene.wall[i]; });
+
+    std::string fps = fmt::format("{:<26}", "frames per second");
+    for (const SceneResult& scene : scenes)
+        fps += fmt::format("{:>10.1f}{:>10}", 1000.0 / median(scene.wall.back().ms), "");
+    fmt::print("{}\n", fps);
+}
+
+Json seriesJson(const std::vector<Series>& all)
+{
+    Json object = Json::object();
+    for (const Series& series : all)
+        object[series.key] = {{"median", median(series.ms)}, {"p90", p90(series.ms)}, {"runs", series.ms}};
+    return object;
+}
+
+int run(const Options& options, const std::string& commandLine)
+{
+    std::vector<cv::Size> sizes;
+    for (const std::string& text : options.sizes)
+        sizes.push_back(parseSize(text));
+
+    QualitySettings quality;
+    quality.samples = options.samples;
+    quality.targetFormat = options.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
+    quality.adaptive = !options.noAdaptive;
+    LensSettings baseLens;
+    baseLens.model = CocModel::ThinLens;
+    baseLens.focusM = options.focusM;
+    baseLens.fNumber = options.fNumber;
+    baseLens.focalLengthMm = options.focalLengthMm;
+    {
+        auto issues = validate(quality);
+        for (const cv::Size size : sizes) {
+            LensSettings lens = baseLens;
+            lens.maxCocPx = options.maxCocAt640 * size.width / 640.0;
+            const auto lensIssues = validate(lens);
+            issues.insert(issues.end(), lensIssues.begin(), lensIssues.end());
+        }
+        for (const auto& issue : issues)
+            fmt::print(stderr, "defocus-bench: error: {}\n", issue.message);
+        if (!issues.empty())
+            return kUsage;
+    }
+
+    const std::vector<Frame> clip = loadClip(options.data);
+    auto context = gl::EglContext::create();
+    const gl::ContextInfo& info = context.info();
+    Pipeline pipeline(!options.noTimers);
+
+    const unsigned cores = std::thread::hardware_concurrency();
+    const std::string cpu = cpuModel();
+    const double loadBefore = loadAverage();
+    fmt::print("defocus-bench, {}\n", utcNow());
+    fmt::print("GL renderer: {}; GL {}; EGL platform: {}\nCPU: {}, {} cores; load average {:.2f} before the runs "
+               "(figures are only comparable on an otherwise idle machine)\n",
+               info.glRenderer, info.glVersion, info.platform, cpu, cores, loadBefore);
+    fmt::print("clip: {} ({} frames, cycled); {} samples, {}, {}; {} runs after {} warm-up frames per scene\n",
+               options.data, clip.size(), quality.samples, options.precision == "32f" ? "RGBA32F" : "RGBA16F",
+               quality.adaptive ? "adaptive (in-focus frames and tiles skipped)" : "every pass on every pixel",
+               options.runs, options.warmup);
+    fmt::print("lens: thin lens {} mm f/{} focused at {} m, 36 mm sensor, max-coc {} px per 640 px of width\n",
+               options.focalLengthMm, options.fNumber, options.focusM, options.maxCocAt640);
+    fmt::print("GPU = GL_TIME_ELAPSED per pass{}; wall = CPU clock; readback waits for the GPU to finish.\n"
+               "Sizes other than the clip's are resized from it (aspect not kept); a row of n/a: the pass did "
+               "not run.\nother processes' CPU %: share of all cores other programs used during the runs; "
+               "above a few %, the figures are inflated.\n",
+               options.noTimers ? " (off: --no-timers)" : info.timerQueries ? "" : " (not offered by this driver: n/a)");
+    fmt::print("command: {}\n", commandLine);
+
+    Json results = Json::array();
+    std::size_t counter = 0; // unique frame index, to match GPU times to their frame
+    for (const cv::Size size : sizes) {
+        LensSettings lens = baseLens;
+        lens.maxCocPx = options.maxCocAt640 * size.width / 640.0;
+        const std::vector<Frame> frames = resizeClip(clip, size);
+        const CocSpread spread = cocSpread(frames, lens);
+
+        fmt::print(stderr, "defocus-bench: measuring {}x{}\n", size.width, size.height);
+        std::vector<SceneResult> scenes;
+        scenes.push_back(measure(pipeline, counter, "defocused", frames, lens, quality, options));
+        scenes.push_back(measure(pipeline, counter, "all in focus",
+                                 inFocusClip(frames, static_cast<float>(lens.focusM)), lens, quality, options));
+
+        fmt::print("\n{}x{}, max-coc {:.0f} px. CoC of the defocused scene: {:.0f}% sharp (<0.5 px), {:.0f}% near, "
+                   "{:.0f}% far, {:.0f}% clamped; |CoC| median {:.1f} px, p90 {:.1f} px\n",
+                   size.width, size.height, lens.maxCocPx, 100 * spread.sharpShare, 100 * spread.nearShare,
+                   100 * spread.farShare, 100 * spread.clampedShare, spread.medianAbsPx, spread.p90AbsPx);
+        printTable(scenes);
+        std::string others = fmt::format("{:<26}", "other processes' CPU %");
+        for (const SceneResult& scene : scenes)
+            others += scene.othersCpuShare < 0 ? fmt::format("{:>10}{:>10}", "n/a", "")
+                                               : fmt::format("{:>10.0f}{:>10}", 100 * scene.othersCpuShare, "");
+        fmt::print("{}\n", others);
+
+        for (const SceneResult& scene : scenes) {
+            Json entry = {{"size", fmt::format("{}x{}", size.width, size.height)},
+                          {"width", size.width},
+                          {"height", size.height},
+                          {"scene", scene.scene},
+                          {"maxCocPx", lens.maxCocPx}};
+            if (scene.scene == "defocused")
+                entry["cocSpread"] = {{"sharpShare", spread.sharpShare},   {"nearShare", spread.nearShare},
+                                      {"farShare", spread.farShare},       {"clampedShare", spread.clampedShare},
+                                      {"medianAbsPx", spread.medianAbsPx}, {"p90AbsPx", spread.p90AbsPx}};
+            entry["othersCpuShare"] = scene.othersCpuShare;
+            entry["gpuMs"] = seriesJson(scene.gpu);
+            entry["wallMs"] = seriesJson(scene.wall);
+            results.push_back(std::move(entry));
+        }
+    }
+
+    if (!options.json.empty()) {
+        const Json document = {
+            {"tool", "defocus-bench"},
+            {"date", utcNow()},
+            {"command", commandLine},
+            {"gl",
+             {{"renderer", info.glRenderer},
+              {"version", info.glVersion},
+              {"vendor", info.glVendor},
+              {"eglPlatform", info.platform},
+              {"timerQueries", info.timerQueries && !options.noTimers}}},
+            {"cpu", {{"model", cpu}, {"cores", cores}, {"loadAverageBefore", loadBefore}}},
+            {"settings",
+             {{"data", options.data},
+              {"runs", options.runs},
+              {"warmup", options.warmup},
+              {"samples", quality.samples},
+              {"precision", options.precision},
+              {"adaptive", quality.adaptive},
+              {"focusM", options.focusM},
+              {"fNumber", options.fNumber},
+              {"focalLengthMm", options.focalLengthMm},
+              {"sensorWidthMm", baseLens.sensorWidthMm},
+              {"maxCocPxPer640", options.maxCocAt640}}},
+            {"results", results}};
+        std::ofstream file(options.json);
+        file << document.dump(2) << '\n';
+        if (!file)
+            throw std::runtime_error(fmt::format("cannot write '{}'", options.json));
+        fmt::print("\nwrote {}\n", options.json);
+    }
+    return kOk;
+}
+
+} // namespace
+
+namespace {
+
+/// `defocus-bench timing ...`: the per-pass timing baseline and comparator (samples/BenchTiming.hpp).
+int timingMain(int argc, char** argv)
+{
+    defocus::TimingOptions o;
+    CLI::App app{"defocus-bench timing: each pass's GPU time over a calibration pass measured in the same run, "
+                 "written as a baseline or compared with one"};
+    app.add_option("--data", o.data, "TUM RGB-D folder to take frames from")->capture_default_str();
+    app.add_option("--baseline", o.baseline, "Compare with this baseline JSON; exit 1 on a regression");
+    app.add_option("--write-baseline", o.writeBaseline, "Write the measured ratios to this JSON file");
+    app.add_option("--runs", o.runs, "Measured frames")->capture_default_str()->check(CLI::Range(3, 10000));
+    app.add_option("--max-ratio", o.maxRatio, "Largest allowed growth of a pass's ratio over the baseline")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    CLI11_PARSE(app, argc, argv);
+    try {
+        return defocus::runTimingComparison(o);
+    } catch (const std::exception& error) {
+        std::fprintf(stderr, "defocus-bench timing: %s\n", error.what());
+        return 2;
+    }
+}
+
+/// `defocus-bench accuracy ...` runs the accuracy sweep, built as its own program beside this one.
+int accuracyMain(int argc, char** argv, const char* self)
+{
+    const std::string program = (std::filesystem::path(self).parent_path() / "defocus-bench-accuracy").string();
+    std::vector<char*> args{const_cast<char*>(program.c_str())};
+    for (int i = 1; i < argc; ++i)
+        args.push_back(argv[i]);
+    args.push_back(nullptr);
+    execv(program.c_str(), args.data());
+    std::fprintf(stderr, "defocus-bench accuracy: cannot run '%s'\n", program.c_str());
+    return 2;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    if (argc > 1 && std::string_view(argv[1]) == "timing")
+        return timingMain(argc - 1, argv + 1);
+    if (argc > 1 && std::string_view(argv[1]) == "accuracy")
+        return accuracyMain(argc - 1, argv + 1, argv[0]);
+    Options o;
+    CLI::App app{"defocus-bench: milliseconds per pass and per frame of the defocus pipeline on the bundled TUM "
+                 "clip, resized to each size; median and p90 of several runs, for a defocused and an all-in-focus "
+                 "scene. Run it from the repository root."};
+    app.add_option("--data", o.data, "TUM RGB-D folder to take frames from")->capture_default_str();
+    app.add_option("--sizes", o.sizes, "Frame sizes WIDTHxHEIGHT, comma-separated")
+        ->delimiter(',')
+        ->capture_default_str();
+    app.add_option("--runs", o.runs, "Measured frames per size and scene")
+        ->check(CLI::Range(1, 100000))
+        ->capture_default_str();
+    app.add_option("--warmup", o.warmup, "Unmeasured frames first, per size and scene")
+        ->check(CLI::Range(0, 1000))
+        ->capture_default_str();
+    app.add_option("--samples", o.samples, "Taps per directional blur pass, 2..64")->capture_default_str();
+    app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f")
+        ->check(CLI::IsMember({"16f", "32f"}))
+        ->capture_default_str();
+    app.add_option("--focus", o.focusM, "Distance in focus, metres")->capture_default_str();
+    app.add_option("--f-number", o.fNumber, "Aperture as an f-number")->capture_default_str();
+    app.add_option("--focal-length", o.focalLengthMm, "Focal length, millimetres")->capture_default_str();
+    app.add_option("--max-coc", o.maxCocAt640, "Largest blur diameter in pixels at 640 px wide; scaled by width/640")
+        ->capture_default_str();
+    app.add_flag("--no-adaptive", o.noAdaptive,
+                 "Run every pass on every pixel (no skipping of in-focus frames and tiles), for comparison");
+    app.add_flag("--no-timers", o.noTimers, "Leave GL timer queries off, to see what timing the passes costs");
+    app.add_option("--json", o.json, "Also write every run, the GL renderer and the date to this JSON file");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+    spdlog::set_pattern("%^defocus-bench: %l:%$ %v");
+    spdlog::set_level(spdlog::level::warn); // keep the library's info lines out of the table
+
+    std::string commandLine = "defocus-bench";
+    for (int i = 1; i < argc; ++i)
+        commandLine += std::string(" ") + argv[i];
+    try {
+        return run(o, commandLine);
+    } catch (const CLI::ValidationError& error) {
+        fmt::print(stderr, "defocus-bench: error: {}\n", error.what());
+        return kUsage;
+    } catch (const std::exception& error) {
+        fmt::print(stderr, "defocus-bench: error: {}\n", error.what());
+        return kFailure;
+    }
+}
