@@ -173,6 +173,7 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     p.fallbackDepth = std::isinf(lens.focusM) ? 1e6f : static_cast<float>(lens.focusM);
     p.rendered = false;
     p.depthPrepared = false;
+    p.plan = {};
 
     // All in focus? Hole filling only averages valid depths, so the valid range bounds the
     // filled map, and CoC is monotonic in depth: the CoC of the two ends decides, before any
