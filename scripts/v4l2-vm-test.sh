@@ -149,9 +149,11 @@ mount -t 9p -o trans=virtio,version=9p2000.L,ro,cache=loose,msize=512000 host0 /
 mount -t devtmpfs devtmpfs /host/dev
 mount -t proc proc /host/proc
 mount -t sysfs sysfs /host/sys
-mount -t tmpfs tmpfs /host/tmp
+# Scratch space in the read-only host root: a tmpfs on /dev/shm, not on /tmp, so that a build
+# tree under the host's /tmp (where CI may clone) stays visible to the chroot.
+mkdir -p /host/dev/shm && mount -t tmpfs tmpfs /host/dev/shm
 echo "v4l2-vm: drivers and host root ready at $(uptime) s"
-run() { chroot /host /usr/bin/env -i PATH=/usr/bin:/bin HOME=/tmp "$@"; }
+run() { chroot /host /usr/bin/env -i PATH=/usr/bin:/bin HOME=/dev/shm TMPDIR=/dev/shm "$@"; }
 run v4l2-ctl --list-devices 2>&1
 echo "v4l2-vm: probe starts at $(uptime) s"
 run DEFOCUS_EXPECT_LOOPBACK=$(arg defocus.loopback) "$(arg defocus.probe)" --gtest_color=no
@@ -162,23 +164,23 @@ if [ -n "$cli" ]; then
   # The command line on vivid (reloaded: the probe unplugged it), unplugged after 2 frames:
   # exit 1 with the message, and the frames written so far complete on disk.
   rmmod vivid && modprobe vivid n_devs=1 node_types=0x1
-  cat >/host/tmp/cli.sh <<'EOS'
-mkdir -p /tmp/out
-"$1" /dev/video0 -o /tmp/out/ >/tmp/cli.log 2>&1 &
+  cat >/host/dev/shm/cli.sh <<'EOS'
+mkdir -p /dev/shm/out
+"$1" /dev/video0 -o /dev/shm/out/ >/dev/shm/cli.log 2>&1 &
 pid=$!
 n=0
-while [ "$(ls /tmp/out | wc -l)" -lt 2 ] && [ $n -lt 1500 ]; do sleep 0.2; n=$((n + 1)); done
+while [ "$(ls /dev/shm/out | wc -l)" -lt 2 ] && [ $n -lt 1500 ]; do sleep 0.2; n=$((n + 1)); done
 v4l2-ctl -d /dev/video0 -c disconnect=1
 wait $pid
 status=$?
-tr '\r' '\n' </tmp/cli.log | grep -v '^frame' | sed 's/^/  /'
+tr '\r' '\n' </dev/shm/cli.log | grep -v '^frame' | sed 's/^/  /'
 complete=0
-for f in /tmp/out/*.png; do tail -c 12 "$f" | grep -q IEND && complete=$((complete + 1)); done
-echo "  defocus exit $status; $(ls /tmp/out | wc -l) frames kept, $complete of them complete PNGs"
-[ $status = 1 ] && [ $complete -ge 2 ] && [ $complete = "$(ls /tmp/out | wc -l)" ] &&
-  grep -q 'disconnected after' /tmp/cli.log
+for f in /dev/shm/out/*.png; do tail -c 12 "$f" | grep -q IEND && complete=$((complete + 1)); done
+echo "  defocus exit $status; $(ls /dev/shm/out | wc -l) frames kept, $complete of them complete PNGs"
+[ $status = 1 ] && [ $complete -ge 2 ] && [ $complete = "$(ls /dev/shm/out | wc -l)" ] &&
+  grep -q 'disconnected after' /dev/shm/cli.log
 EOS
-  run /bin/sh /tmp/cli.sh "$cli" || rc=1
+  run /bin/sh /dev/shm/cli.sh "$cli" || rc=1
   echo "v4l2-vm: command line done at $(uptime) s"
 fi
 echo "V4L2-VM-RESULT $rc at $(uptime) s"
