@@ -50,7 +50,9 @@ public:
     Pipeline(const Pipeline&) = delete;
     Pipeline& operator=(const Pipeline&) = delete;
 
-    /// Runs the passes for `frame`. `lens` and `quality` must have passed validate().
+    /// Runs the passes for `frame` (or only decides that nothing needs to run). `lens` and
+    /// `quality` must have passed validate(). The frame's images are referenced, not copied,
+    /// until the next process(): leave them unchanged until read() has been called.
     void process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality);
     /// Renders `view` of the last processed frame and reads it back. Depth and CoC views carry a
     /// legend along their bottom edge.
