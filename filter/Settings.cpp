@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -84,6 +85,39 @@ std::vector<SettingIssue> validate(QualitySettings& quality, bool clamp)
 {
     std::vector<SettingIssue> issues;
     checkRange(issues, "--samples", quality.samples, limits::kSamples[0], limits::kSamples[1], clamp);
+    return issues;
+}
+
+bool parseFocus(std::string_view text, LensSettings& lens, bool& isAuto)
+{
+    isAuto = text == "auto";
+    if (isAuto)
+        return true;
+    if (text == "inf" || text == "infinity") {
+        lens.focusM = std::numeric_limits<double>::infinity();
+        return true;
+    }
+    try {
+        const std::string value(text);
+        std::size_t used = 0;
+        const double metres = std::stod(value, &used);
+        if (used != value.size())
+            return false;
+        lens.focusM = metres;
+        return true;
+    } catch (const std::logic_error&) {
+        return false;
+    }
+}
+
+std::vector<SettingIssue> validateCommandLine(const LensSettings& lens, QualitySettings quality, bool autoFocus)
+{
+    LensSettings checked = lens;
+    if (autoFocus)
+        checked.focusM = std::max(checked.focusM, checked.focalLengthMm * 2e-3);
+    auto issues = validate(checked);
+    const auto qualityIssues = validate(quality);
+    issues.insert(issues.end(), qualityIssues.begin(), qualityIssues.end());
     return issues;
 }
 

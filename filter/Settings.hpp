@@ -84,6 +84,15 @@ struct SettingIssue {
 std::vector<SettingIssue> validate(LensSettings& lens, bool clamp = false);
 std::vector<SettingIssue> validate(QualitySettings& quality, bool clamp = false);
 
+/// Parses a --focus value: metres, "inf"/"infinity" (focus at infinity) or "auto" (chosen from
+/// the depth later; `lens.focusM` is left alone and `isAuto` set). Returns false for anything
+/// else, leaving `lens` unchanged.
+bool parseFocus(std::string_view text, LensSettings& lens, bool& isAuto);
+
+/// The strict check of a command line: validate() of both structs, with an automatic focus
+/// treated as valid (it is chosen, and checked, once the first depth is known).
+std::vector<SettingIssue> validateCommandLine(const LensSettings& lens, QualitySettings quality, bool autoFocus);
+
 namespace limits {
 inline constexpr double kFocalLengthMm[] = {1.0, 1200.0};
 inline constexpr double kFNumber[] = {0.7, 64.0};

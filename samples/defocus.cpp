@@ -368,25 +368,12 @@ int main(int argc, char** argv)
         o.quality.adaptive = !alwaysOn;
         o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
         o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
-        if (o.focus == "inf" || o.focus == "infinity") {
-            o.lens.focusM = std::numeric_limits<double>::infinity();
-        } else if (o.focus != "auto") {
-            try {
-                std::size_t used = 0;
-                o.lens.focusM = std::stod(o.focus, &used);
-                if (used != o.focus.size())
-                    throw std::invalid_argument(o.focus);
-            } catch (const std::logic_error&) {
-                spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);
-                return kUsage;
-            }
+        bool autoFocus = false;
+        if (!parseFocus(o.focus, o.lens, autoFocus)) {
+            spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);
+            return kUsage;
         }
-        LensSettings lensToCheck = o.lens;
-        if (o.focus == "auto")
-            lensToCheck.focusM = std::max(lensToCheck.focusM, lensToCheck.focalLengthMm * 2e-3);
-        auto issues = validate(lensToCheck);
-        const auto qualityIssues = validate(o.quality);
-        issues.insert(issues.end(), qualityIssues.begin(), qualityIssues.end());
+        const auto issues = validateCommandLine(o.lens, o.quality, autoFocus);
         for (const auto& issue : issues)
             spdlog::error("{}", issue.message);
         if (!issues.empty())

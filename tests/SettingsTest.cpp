@@ -60,6 +60,35 @@ TEST(Settings, ClampModeFixesEveryValueAndStillReports)
     EXPECT_TRUE(validate(quality).empty());
 }
 
+TEST(Settings, FocusParsesMetresInfinityAndAuto)
+{
+    LensSettings lens;
+    bool isAuto = true;
+    ASSERT_TRUE(parseFocus("1.25", lens, isAuto));
+    EXPECT_FALSE(isAuto);
+    EXPECT_DOUBLE_EQ(lens.focusM, 1.25);
+    ASSERT_TRUE(parseFocus("inf", lens, isAuto));
+    EXPECT_TRUE(std::isinf(lens.focusM));
+    ASSERT_TRUE(parseFocus("auto", lens, isAuto));
+    EXPECT_TRUE(isAuto);
+    lens.focusM = 3.0;
+    EXPECT_FALSE(parseFocus("3m", lens, isAuto)) << "trailing text is not a distance";
+    EXPECT_FALSE(parseFocus("abc", lens, isAuto));
+    EXPECT_FALSE(parseFocus("", lens, isAuto));
+    EXPECT_DOUBLE_EQ(lens.focusM, 3.0) << "a rejected value leaves the lens alone";
+}
+
+TEST(Settings, CommandLineCheckAcceptsAutoFocusButNotABadOne)
+{
+    LensSettings lens;
+    lens.focusM = 0.01; // below the 50 mm focal length
+    EXPECT_EQ(validateCommandLine(lens, {}, false).size(), 1u);
+    EXPECT_TRUE(validateCommandLine(lens, {}, true).empty()) << "auto focus is chosen later";
+    QualitySettings quality;
+    quality.samples = 1;
+    EXPECT_EQ(validateCommandLine(lens, quality, true).size(), 1u);
+}
+
 TEST(Settings, ViewNamesRoundTrip)
 {
     for (const View v : kAllViews) {
