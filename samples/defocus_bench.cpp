@@ -29,6 +29,7 @@
 #include "filter/Settings.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "sources/FrameSource.hpp"
+#include "samples/BenchMachine.hpp"
 #include "samples/BenchTiming.hpp"
 
 #include <unistd.h>
@@ -116,27 +117,6 @@ cv::Size parseSize(const std::string& text)
         (separator != 'x' && separator != 'X') || width < 16 || height < 16 || width > 8192 || height > 8192)
         throw CLI::ValidationError("--sizes", fmt::format("'{}' is not WIDTHxHEIGHT with sides in [16, 8192]", text));
     return {width, height};
-}
-
-std::string utcNow()
-{
-    const std::time_t now = std::time(nullptr);
-    std::tm utc{};
-    gmtime_r(&now, &utc);
-    char text[32];
-    std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
-    return text;
-}
-
-std::string cpuModel()
-{
-    std::ifstream cpuinfo("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(cpuinfo, line))
-        if (line.rfind("model name", 0) == 0)
-            if (const auto colon = line.find(':'); colon != std::string::npos)
-                return line.substr(line.find_first_not_of(' ', colon + 1));
-    return "unknown";
 }
 
 /// The 1-minute load average, to tell a quiet machine from a busy one; -1 when unknown.

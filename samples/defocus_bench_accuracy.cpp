@@ -36,6 +36,7 @@
 #include "filter/methods/Method.hpp"
 #include "filter/methods/Presets.hpp"
 #include "sources/ImageIO.hpp"
+#include "samples/BenchMachine.hpp"
 
 namespace {
 
@@ -92,27 +93,6 @@ double median(std::vector<double> values)
     std::sort(values.begin(), values.end());
     const std::size_t n = values.size();
     return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-std::string utcNow()
-{
-    const std::time_t now = std::time(nullptr);
-    std::tm utc{};
-    gmtime_r(&now, &utc);
-    char text[32];
-    std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
-    return text;
-}
-
-std::string cpuModel()
-{
-    std::ifstream cpuinfo("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(cpuinfo, line))
-        if (line.rfind("model name", 0) == 0)
-            if (const auto colon = line.find(':'); colon != std::string::npos)
-                return line.substr(line.find_first_not_of(' ', colon + 1));
-    return "unknown";
 }
 
 double loadAverage()
