@@ -41,19 +41,6 @@ MethodSettings settingsFor(const MethodInfo& info, Resolution resolution, Target
     return {samples, resolution, precision};
 }
 
-// A lens whose CoC at 2 m is exactly `diameterPx`: the focal-range model, focus 1 m, blur reaching
-// max-coc at the far limit 2 m.
-LensSettings lensWithFarCoc(double diameterPx)
-{
-    LensSettings lens;
-    lens.model = CocModel::FocalRange;
-    lens.focusM = 1.0;
-    lens.nearLimitM = 0.5;
-    lens.farLimitM = 2.0;
-    lens.maxCocPx = diameterPx;
-    return lens;
-}
-
 TEST_F(Methods, RegistryNamesAreUniqueAndCreatable)
 {
     for (const MethodInfo& info : methodRegistry()) {
@@ -163,7 +150,7 @@ TEST_F(Methods, ReferenceTurnsAPointLightIntoAHexagonOfThePredictedAreaAndKeepsI
     cv::Mat color(size, size, CV_32FC3, cv::Scalar::all(0.0));
     color.at<cv::Vec3f>(size / 2, size / 2) = cv::Vec3f(light, light, light);
     const Frame frame{color, cv::Mat(color.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "point"};
-    const cv::Mat out = createMethod("reference")->run(frame, lensWithFarCoc(diameter), {}).linear;
+    const cv::Mat out = createMethod("reference")->run(frame, test::lensWithFarCoc(diameter), {}).linear;
     cv::Mat gray;
     cv::cvtColor(out, gray, cv::COLOR_BGR2GRAY);
 
@@ -187,7 +174,7 @@ TEST_F(Methods, ReferenceTurnsAPointLightIntoAHexagonOfThePredictedAreaAndKeepsI
 
     // "reference-pointy" turns the same hexagon by 90 degrees: a corner on top, as Cycles renders.
     cv::Mat pointy;
-    cv::cvtColor(createMethod("reference-pointy")->run(frame, lensWithFarCoc(diameter), {}).linear, pointy,
+    cv::cvtColor(createMethod("reference-pointy")->run(frame, test::lensWithFarCoc(diameter), {}).linear, pointy,
                  cv::COLOR_BGR2GRAY);
     EXPECT_NEAR(cv::sum(pointy)[0], light, 0.01 * light);
     EXPECT_NEAR(cv::countNonZero(pointy.row(size / 2) > 0.0f), diameter * std::numbers::sqrt3 / 2.0, 2.0);

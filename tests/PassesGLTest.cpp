@@ -17,19 +17,6 @@ namespace {
 
 class Passes : public test::GLTest {};
 
-// A lens whose CoC at `depth` metres is exactly `diameterPx` in an image `width` wide: the
-// focal-range model with the far limit where blur reaches max-coc.
-LensSettings lensWithFarCoc(double diameterPx)
-{
-    LensSettings lens;
-    lens.model = CocModel::FocalRange;
-    lens.focusM = 1.0;
-    lens.nearLimitM = 0.5;
-    lens.farLimitM = 2.0;
-    lens.maxCocPx = diameterPx;
-    return lens;
-}
-
 TEST_F(Passes, ZeroCocReturnsTheInput)
 {
     cv::Mat color(97, 131, CV_8UC3);
@@ -63,7 +50,7 @@ TEST_F(Passes, PointLightBecomesAFlatTopHexagonOfThePredictedArea)
     quality.samples = 48; // taps under one pixel apart, so the 1-px light is never skipped
     quality.targetFormat = TargetFormat::Rgba32F;
     Pipeline pipeline;
-    const cv::Mat out = pipeline.run(frame, lensWithFarCoc(diameter), quality, View::Composite, Encoding::Linear32F);
+    const cv::Mat out = pipeline.run(frame, test::lensWithFarCoc(diameter), quality, View::Composite, Encoding::Linear32F);
     cv::Mat gray;
     cv::cvtColor(out, gray, cv::COLOR_BGR2GRAY);
 
@@ -117,7 +104,7 @@ TEST_F(Passes, ConstantDepthBlursUniformly)
             color.at<cv::Vec3f>(y, x) = cv::Vec3f::all(((x / 2 + y / 2) % 2) ? 1.0f : 0.0f);
     Frame frame{color, cv::Mat(color.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "checker"};
     Pipeline pipeline;
-    const cv::Mat out = pipeline.run(frame, lensWithFarCoc(24.0), {}, View::Composite, Encoding::Linear32F);
+    const cv::Mat out = pipeline.run(frame, test::lensWithFarCoc(24.0), {}, View::Composite, Encoding::Linear32F);
     const cv::Rect interior(30, 30, color.cols - 60, color.rows - 60);
     cv::Scalar mean, stddev;
     cv::meanStdDev(out(interior), mean, stddev);
@@ -161,7 +148,7 @@ TEST_F(Passes, HdrEnergyIsKeptThroughTheLinearPath)
     cv::Mat color(64, 64, CV_32FC3, cv::Scalar::all(50.0));
     Pipeline pipeline;
     cv::Mat out = pipeline.run({color, cv::Mat(color.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "hdr"},
-                               lensWithFarCoc(12.0), {}, View::Composite, Encoding::Linear32F);
+                               test::lensWithFarCoc(12.0), {}, View::Composite, Encoding::Linear32F);
     double lo = 0, hi = 0;
     cv::minMaxLoc(out.reshape(1), &lo, &hi);
     // Half-float targets hold 50 to 11 bits: 50 * 2^-11 = 0.025.
@@ -171,7 +158,7 @@ TEST_F(Passes, HdrEnergyIsKeptThroughTheLinearPath)
     color.setTo(cv::Scalar::all(0.0));
     color(cv::Rect(28, 28, 8, 8)).setTo(cv::Scalar::all(1e4));
     out = pipeline.run({color, cv::Mat(color.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "hdr"},
-                       lensWithFarCoc(12.0), {}, View::Composite, Encoding::Linear32F);
+                       test::lensWithFarCoc(12.0), {}, View::Composite, Encoding::Linear32F);
     const double energyIn = cv::sum(color)[0], energyOut = cv::sum(out)[0];
     EXPECT_GT(energyOut, 0.6 * energyIn);
     EXPECT_LE(energyOut, 1.01 * energyIn);

@@ -18,6 +18,17 @@ std::filesystem::path scratchDir(const std::string& name)
     return dir;
 }
 
+LensSettings lensWithFarCoc(double diameterPx)
+{
+    LensSettings lens;
+    lens.model = CocModel::FocalRange;
+    lens.focusM = 1.0;
+    lens.nearLimitM = 0.5;
+    lens.farLimitM = 2.0;
+    lens.maxCocPx = diameterPx;
+    return lens;
+}
+
 bool allFinite(const cv::Mat& m)
 {
     if (m.depth() != CV_32F && m.depth() != CV_64F && m.depth() != CV_16F)
