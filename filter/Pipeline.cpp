@@ -18,6 +18,7 @@
 #include "filter/passes/CompositePass.hpp"
 #include "filter/passes/CopyPass.hpp"
 #include "filter/passes/HexBlurPass.hpp"
+#include "filter/passes/RhombusBlurPass.hpp"
 #include "filter/passes/NearBlurPass.hpp"
 #include "filter/passes/ViewPass.hpp"
 
@@ -37,14 +38,16 @@ struct Target {
     gl::Texture texture;
     gl::Framebuffer framebuffer;
 
-    void ensure(GLenum format, cv::Size size, const char* name)
+    /// Returns true when the texture was (re)created: framebuffers holding it need remaking.
+    bool ensure(GLenum format, cv::Size size, const char* name)
     {
         if (texture && texture.format() == format && texture.width() == size.width &&
             texture.height() == size.height)
-            return;
+            return false;
         framebuffer = {};
         texture = gl::Texture(format, size.width, size.height, name);
         framebuffer = gl::Framebuffer(texture, name);
+        return true;
     }
 };
 
@@ -78,6 +81,7 @@ struct Pipeline::Impl {
     gl::VertexArray vao = gl::VertexArray::create();
     CocPass cocPass;
     HexBlurPass hexBlurPass;
+    RhombusBlurPass rhombusBlurPass;
     CompositePass compositePass;
     CopyPass copyPass;
     NearBlurPass nearBlurPass;
@@ -88,6 +92,9 @@ struct Pipeline::Impl {
     gl::Texture colorTexture;
     gl::Texture depth;
     Target coc, horizontal, diagonalA, diagonalB, outSrgb, outLinear;
+    // Rhombi: pass 1 writes X (horizontal) and Y (horizontalMean), pass 2 A and B (diagonalA/B).
+    Target horizontalMean;
+    gl::Framebuffer firstPair, secondPair;
     Target nearHorizontal, nearA, nearB; ///< the foreground layer's blurs
     gl::Texture nearDiameter;            ///< per tile, R32F
 
@@ -102,6 +109,7 @@ struct Pipeline::Impl {
     cv::Mat color;
     CocCoefficients coefficients;
     QualitySettings quality;
+    float bladeRotationDeg = 0.0f;
     SceneAnalysis analysis;
     FramePlan plan;
     bool rendered = false;
@@ -112,6 +120,9 @@ struct Pipeline::Impl {
     std::size_t gpuFrameIndex = 0; ///< frame whose GPU scopes are pending in the timer
 
     void render();
+    void renderMcIntosh(bool useTiles);
+    void renderRhombi(bool useTiles);
+    void uploadNearDiameter();
     void prepareDepthAndPlan();
 
     explicit Impl(bool timers) : timer(timers) {}
@@ -167,6 +178,7 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     p.color = frame.color;
     p.depthInput = frame.depth;
     p.quality = quality;
+    p.bladeRotationDeg = static_cast<float>(lens.bladeRotationDeg);
     p.coefficients = cocCoefficients(lens, p.size.width);
     p.maxCocPx = p.coefficients.maxCocPx;
     p.frameIndex = frame.index;
@@ -207,8 +219,82 @@ void Pipeline::Impl::prepareDepthAndPlan()
     depthPrepared = true;
     analysis = analyseScene(prepared.metres, color, coefficients, prepared.invalidFraction);
     const bool allInFocus = plan.allInFocus && quality.adaptive;
-    plan = makePlan(analysis, quality.nearField);
+    plan = makePlan(analysis, quality.nearField, quality.kernel);
     plan.allInFocus = plan.allInFocus || allInFocus;
+}
+
+void Pipeline::Impl::uploadNearDiameter()
+{
+    ensureTexture(nearDiameter, GL_R32F, analysis.tiles, "near diameter per tile");
+    CV_Assert(analysis.tileNearDiameter.isContinuous());
+    nearDiameter.upload(GL_RED, GL_FLOAT, analysis.tileNearDiameter.data);
+}
+
+void Pipeline::Impl::renderMcIntosh(bool useTiles)
+{
+    const GLenum format = coc.texture.format();
+    horizontal.ensure(format, size, "horizontal");
+    diagonalA.ensure(format, size, "diagonal A");
+    diagonalB.ensure(format, size, "diagonal B");
+    // McIntosh et al.'s first pass runs along an edge of the hexagon. Edges and corners point
+    // the same ways (mod 60 deg), so the edge nearest an axis is the rhombi's u1: with a corner
+    // on top (rotation 0) the edges are vertical and the passes run at 90 and 90 +- 120 deg; with
+    // a flat top (30) at 0 and +-120, as published.
+    const float first = RhombusBlurPass::directions(bladeRotationDeg).u1;
+    const auto blur = [&](const char* name, const gl::Texture& source, float angle, const Target& target) {
+        timer.begin(name);
+        hexBlurPass.run(source, depth, angle, quality.samples, target.framebuffer, useTiles ? &blurTiles : nullptr);
+        if (useTiles)
+            copyPass.run(source, copyTiles, target.framebuffer);
+        timer.end();
+    };
+    blur("horizontal", coc.texture, first, horizontal);
+    blur("diagonal-a", horizontal.texture, first + 120.0f, diagonalA);
+    blur("diagonal-b", horizontal.texture, first - 120.0f, diagonalB);
+
+    if (plan.nearField) {
+        nearHorizontal.ensure(format, size, "near horizontal");
+        nearA.ensure(format, size, "near A");
+        nearB.ensure(format, size, "near B");
+        uploadNearDiameter();
+        nearTiles.set(plan.nearTiles, size, SceneAnalysis::kTileSize);
+        timer.begin("near-field");
+        nearBlurPass.run(coc.texture, nearDiameter, first, quality.samples, true, nearHorizontal.framebuffer, nearTiles);
+        nearBlurPass.run(nearHorizontal.texture, nearDiameter, first + 120.0f, quality.samples, false,
+                         nearA.framebuffer, nearTiles);
+        nearBlurPass.run(nearHorizontal.texture, nearDiameter, first - 120.0f, quality.samples, false,
+                         nearB.framebuffer, nearTiles);
+        timer.end();
+    }
+}
+
+void Pipeline::Impl::renderRhombi(bool useTiles)
+{
+    const GLenum format = coc.texture.format();
+    // Bitwise |: every target must be ensured, and any one remade means remaking its pair.
+    if (horizontal.ensure(format, size, "rhombi X") | horizontalMean.ensure(format, size, "rhombi Y") || !firstPair)
+        firstPair = gl::Framebuffer(horizontal.texture, horizontalMean.texture, "rhombi pass 1");
+    if (diagonalA.ensure(format, size, "rhombi A") | diagonalB.ensure(format, size, "rhombi B") || !secondPair)
+        secondPair = gl::Framebuffer(diagonalA.texture, diagonalB.texture, "rhombi pass 2");
+    const gl::Texture* near = nullptr;
+    if (plan.nearField) {
+        uploadNearDiameter();
+        near = &nearDiameter;
+    }
+    const auto directions = RhombusBlurPass::directions(bladeRotationDeg);
+    const TileList* tiles = useTiles ? &blurTiles : nullptr;
+    timer.begin("rhombi-1");
+    rhombusBlurPass.run({coc.texture, nullptr, near, firstPair}, true, directions, quality.samples,
+                        SceneAnalysis::kTileSize, tiles);
+    if (useTiles)
+        copyPass.run(coc.texture, copyTiles, firstPair, true);
+    timer.end();
+    timer.begin("rhombi-2");
+    rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, secondPair}, false, directions,
+                        quality.samples, SceneAnalysis::kTileSize, tiles);
+    if (useTiles)
+        copyPass.run(horizontal.texture, copyTiles, secondPair, true);
+    timer.end();
 }
 
 void Pipeline::Impl::render()
@@ -226,11 +312,7 @@ void Pipeline::Impl::render()
 
     start = Clock::now();
     const bool half = quality.targetFormat == TargetFormat::Rgba16F;
-    const GLenum format = half ? GL_RGBA16F : GL_RGBA32F;
-    coc.ensure(format, size, "coc");
-    horizontal.ensure(format, size, "horizontal");
-    diagonalA.ensure(format, size, "diagonal A");
-    diagonalB.ensure(format, size, "diagonal B");
+    coc.ensure(half ? GL_RGBA16F : GL_RGBA32F, size, "coc");
 
     // Tiles in focus are copied, not blurred, when enough of them are: a thousand small quads
     // cost the rasteriser more than one full-screen triangle (on llvmpipe, drawing 1181 of 1200
@@ -241,38 +323,14 @@ void Pipeline::Impl::render()
         blurTiles.set(plan.blurTiles, size, SceneAnalysis::kTileSize);
         copyTiles.set(plan.copyTiles, size, SceneAnalysis::kTileSize);
     }
-    const auto blur = [&](const char* name, const gl::Texture& source, float angle, const Target& target) {
-        timer.begin(name);
-        hexBlurPass.run(source, depth, angle, quality.samples, target.framebuffer, useTiles ? &blurTiles : nullptr);
-        if (useTiles)
-            copyPass.run(source, copyTiles, target.framebuffer);
-        timer.end();
-    };
-
     glBindVertexArray(vao.id());
     timer.begin(CocPass::kName);
     cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer);
     timer.end();
-    blur("horizontal", coc.texture, 0.0f, horizontal);
-    blur("diagonal-a", horizontal.texture, 120.0f, diagonalA);
-    blur("diagonal-b", horizontal.texture, -120.0f, diagonalB);
-
-    if (plan.nearField) {
-        nearHorizontal.ensure(format, size, "near horizontal");
-        nearA.ensure(format, size, "near A");
-        nearB.ensure(format, size, "near B");
-        ensureTexture(nearDiameter, GL_R32F, analysis.tiles, "near diameter per tile");
-        CV_Assert(analysis.tileNearDiameter.isContinuous());
-        nearDiameter.upload(GL_RED, GL_FLOAT, analysis.tileNearDiameter.data);
-        nearTiles.set(plan.nearTiles, size, SceneAnalysis::kTileSize);
-        timer.begin("near-field");
-        nearBlurPass.run(coc.texture, nearDiameter, 0.0f, quality.samples, true, nearHorizontal.framebuffer, nearTiles);
-        nearBlurPass.run(nearHorizontal.texture, nearDiameter, 120.0f, quality.samples, false, nearA.framebuffer,
-                         nearTiles);
-        nearBlurPass.run(nearHorizontal.texture, nearDiameter, -120.0f, quality.samples, false, nearB.framebuffer,
-                         nearTiles);
-        timer.end();
-    }
+    if (quality.kernel == HexagonKernel::RhombiSum)
+        renderRhombi(useTiles);
+    else
+        renderMcIntosh(useTiles);
     timings.renderMs = msSince(start);
     rendered = true;
 }
@@ -309,8 +367,11 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
     if (view == View::Composite) {
         p.timer.begin(CompositePass::kName);
         const bool near = p.plan.nearField;
-        p.compositePass.run(p.diagonalA.texture, p.diagonalB.texture, out.framebuffer,
-                            near ? &p.nearA.texture : nullptr, near ? &p.nearB.texture : nullptr);
+        if (p.quality.kernel == HexagonKernel::RhombiSum)
+            p.compositePass.runSum(p.diagonalA.texture, p.diagonalB.texture, out.framebuffer);
+        else
+            p.compositePass.run(p.diagonalA.texture, p.diagonalB.texture, out.framebuffer,
+                                near ? &p.nearA.texture : nullptr, near ? &p.nearB.texture : nullptr);
     } else {
         p.timer.begin(ViewPass::kName);
         if (view == View::Depth) {

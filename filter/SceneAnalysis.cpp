@@ -86,7 +86,7 @@ SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, con
     return a;
 }
 
-FramePlan makePlan(const SceneAnalysis& analysis, bool nearField)
+FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel kernel)
 {
     FramePlan plan;
     plan.allInFocus = analysis.maxAbsCoc() < 0.5f;
@@ -96,11 +96,15 @@ FramePlan makePlan(const SceneAnalysis& analysis, bool nearField)
     if (plan.allInFocus)
         return plan;
     plan.nearField = nearField && analysis.foreground;
+    plan.kernel = kernel;
     for (int y = 0; y < analysis.tiles.height; ++y)
         for (int x = 0; x < analysis.tiles.width; ++x) {
-            (analysis.tileNeedsBlur(x, y) ? plan.blurTiles : plan.copyTiles).emplace_back(x, y);
-            if (plan.nearField && analysis.tileNearDiameter.at<float>(y, x) >= 0.5f)
+            const bool near = plan.nearField && analysis.tileNearDiameter.at<float>(y, x) >= 0.5f;
+            if (near)
                 plan.nearTiles.emplace_back(x, y);
+            // The rhombus blur handles the foreground itself: tiles it reaches are blurred too.
+            const bool blur = analysis.tileNeedsBlur(x, y) || (near && kernel == HexagonKernel::RhombiSum);
+            (blur ? plan.blurTiles : plan.copyTiles).emplace_back(x, y);
         }
     return plan;
 }
@@ -110,7 +114,8 @@ std::string FramePlan::explain(const SceneAnalysis& analysis) const
     const int total = analysis.tiles.area();
     std::string text = allInFocus ? fmt::format("all in focus (max |CoC| {:.2f} px): input passed through, no pass ran",
                                                 analysis.maxAbsCoc())
-                                  : fmt::format("coc, blur x3 on {}/{} tiles (copy {}), composite; CoC {:+.1f}..{:+.1f} px",
+                                  : fmt::format("coc, blur {} on {}/{} tiles (copy {}), composite; CoC {:+.1f}..{:+.1f} px",
+                                                kernel == HexagonKernel::RhombiSum ? "rhombi x2" : "mcintosh x3",
                                                 blurTiles.size(), total, copyTiles.size(), analysis.minCoc,
                                                 analysis.maxCoc);
     if (allInFocus)

@@ -51,12 +51,15 @@ struct FramePlan {
     bool foreground = false;          ///< the frame has near blur
     bool nearField = false;           ///< the foreground layer passes run
     std::vector<cv::Point> nearTiles; ///< tiles the foreground layer covers
+    HexagonKernel kernel = HexagonKernel::McIntoshMin; ///< the blur passes' kind, for explain()
 
     /// One line for --explain, e.g. "blur 812/1200 tiles, copy 388; hole fill on (24.1 % invalid)".
     std::string explain(const SceneAnalysis& analysis) const;
 };
 
-/// `nearField`: run the foreground layer when the frame has foreground blur.
-FramePlan makePlan(const SceneAnalysis& analysis, bool nearField = true);
+/// `nearField`: spread foreground blur when the frame has some: McIntosh runs the foreground
+/// layer on nearTiles; the rhombus blur reaches over them itself, so they join blurTiles.
+FramePlan makePlan(const SceneAnalysis& analysis, bool nearField = true,
+                   HexagonKernel kernel = HexagonKernel::McIntoshMin);
 
 } // namespace defocus

@@ -51,6 +51,8 @@ std::vector<SettingIssue> validate(LensSettings& lens, bool clamp)
     checkRange(issues, "--f-number", lens.fNumber, limits::kFNumber[0], limits::kFNumber[1], clamp);
     checkRange(issues, "--sensor-width", lens.sensorWidthMm, limits::kSensorWidthMm[0], limits::kSensorWidthMm[1], clamp);
     checkRange(issues, "--max-coc", lens.maxCocPx, limits::kMaxCocPx[0], limits::kMaxCocPx[1], clamp);
+    checkRange(issues, "--blade-rotation", lens.bladeRotationDeg, limits::kBladeRotationDeg[0],
+               limits::kBladeRotationDeg[1], clamp);
 
     // The thin lens only images points beyond its focal length: focus must be farther than f.
     const double focalLengthM = lens.focalLengthMm * 1e-3;
@@ -86,6 +88,21 @@ std::vector<SettingIssue> validate(QualitySettings& quality, bool clamp)
     std::vector<SettingIssue> issues;
     checkRange(issues, "--samples", quality.samples, limits::kSamples[0], limits::kSamples[1], clamp);
     return issues;
+}
+
+std::string_view kernelName(HexagonKernel kernel)
+{
+    return kernel == HexagonKernel::McIntoshMin ? "mcintosh" : "rhombi";
+}
+
+bool parseKernel(std::string_view name, HexagonKernel& kernel)
+{
+    for (const HexagonKernel k : {HexagonKernel::McIntoshMin, HexagonKernel::RhombiSum})
+        if (name == kernelName(k)) {
+            kernel = k;
+            return true;
+        }
+    return false;
 }
 
 bool parseFocus(std::string_view text, LensSettings& lens, bool& isAuto)

@@ -28,6 +28,11 @@ struct LensSettings {
     double sensorWidthMm = 36.0;
     /// Largest CoC diameter, pixels, [0, 512]; larger blur is clamped to it.
     double maxCocPx = 32.0;
+    /// Rotation of the hexagonal aperture, degrees counter-clockwise as seen in the image,
+    /// [-180, 180]. 0 puts a corner straight up, as Blender Cycles' blade rotation 0 renders
+    /// (measured on data/blender_spheres; see docs/accuracy.md); 30 (or 90) puts a flat edge on
+    /// top, as in McIntosh et al.'s figures.
+    double bladeRotationDeg = 0.0;
     /// FocalRange model only: distance where blur reaches max-coc in front of the focus, metres,
     /// [0, focusM).
     double nearLimitM = 1.0;
@@ -42,16 +47,35 @@ enum class TargetFormat {
     Rgba32F  ///< full float
 };
 
+/// How the directional blurs make a hexagon.
+enum class HexagonKernel {
+    /// McIntosh, Riecke & DiPaola 2012 as published: blur along 0 deg, then +120 and -120 deg of
+    /// that, and the per-channel min() of the two. Three passes and a composite; the min() keeps
+    /// about 3/4 of a highlight's energy and darkens texture.
+    McIntoshMin,
+    /// Three one-sided rhombi summed (shaders/rhombus_blur.frag): a flat hexagon that keeps
+    /// all of the energy, in two passes of two lines each and a composite. With nearField,
+    /// foreground spreads by its own CoC ("scatter as gather").
+    RhombiSum
+};
+
+std::string_view kernelName(HexagonKernel kernel); ///< "mcintosh", "rhombi"
+/// Parses a name as printed by kernelName(); returns false when unknown.
+bool parseKernel(std::string_view name, HexagonKernel& kernel);
+
 struct QualitySettings {
-    /// Taps per directional blur pass, [2, 64].
+    /// Taps per directional blur, [2, 64]: per centred segment (McIntosh), per one-sided line
+    /// (rhombi; lines shorter than the taps are long take one tap per pixel).
     int samples = 16;
+    HexagonKernel kernel = HexagonKernel::RhombiSum;
     TargetFormat targetFormat = TargetFormat::Rgba16F;
     /// Follow the per-frame plan: skip every pass when the frame is all in focus and blur only
     /// the tiles that need it. false runs every pass on every pixel (for comparisons).
     bool adaptive = true;
-    /// Spread blurred foreground over what is behind it (a near-field layer, composited over the
-    /// McIntosh result). Runs only on frames, and tiles, with foreground blur. Off by default:
-    /// the published chain keeps pixels in focus unchanged, which the layer does not.
+    /// Spread blurred foreground over what is behind it. McIntosh: a near-field layer,
+    /// composited over the result. Rhombi: each line reaches as far as the foreground that can
+    /// reach the pixel, and foreground taps count by their own CoC. Runs only on frames, and
+    /// tiles, with foreground blur.
     bool nearField = false;
 };
 
@@ -98,6 +122,7 @@ inline constexpr double kFocalLengthMm[] = {1.0, 1200.0};
 inline constexpr double kFNumber[] = {0.7, 64.0};
 inline constexpr double kSensorWidthMm[] = {1.0, 100.0};
 inline constexpr double kMaxCocPx[] = {0.0, 512.0};
+inline constexpr double kBladeRotationDeg[] = {-180.0, 180.0};
 inline constexpr int kSamples[] = {2, 64};
 } // namespace limits
 

@@ -56,6 +56,7 @@ struct Options {
     bool halfResolution = false; ///< from a preset: blur at half size, upscale the result
     std::string model = "thin-lens";
     std::string precision = "16f";
+    std::string kernel = "rhombi";
     std::string view = "composite";
     std::string contactSheet;
     std::size_t contactFrame = 0;
@@ -319,7 +320,14 @@ int main(int argc, char** argv)
                    "(16 taps), high (48 taps); --samples and --precision override it")
         ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
-    app.add_option("--samples", o.quality.samples, "Taps per directional blur pass, 2..64 [default: from --quality]");
+    app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
+    app.add_option("--hexagon", o.kernel,
+                   "How the blurs make the hexagon: rhombi (three one-sided rhombi summed, keeps highlight energy) "
+                   "or mcintosh (McIntosh et al. 2012, min of two) [default: from --quality]")
+        ->check(CLI::IsMember({"rhombi", "mcintosh"}));
+    app.add_option("--blade-rotation", o.lens.bladeRotationDeg,
+                   "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top (as Blender Cycles), 30 = flat top")
+        ->capture_default_str();
     app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
         ->check(CLI::IsMember({"16f", "32f"}));
     std::vector<std::string> views;
@@ -335,8 +343,8 @@ int main(int argc, char** argv)
     app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
     app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
     bool alwaysOn = false;
-    app.add_flag("--near-field", o.quality.nearField,
-                 "Spread blurred foreground over what is behind it (a near-field layer; +0.5 dB on the Blender scene)");
+    app.add_flag("--near-field,!--no-near-field", o.quality.nearField,
+                 "Spread blurred foreground over what is behind it [default: from --quality]");
     app.add_flag("--always-on", alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
     app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
     app.add_flag("-q,--quiet", o.quiet, "Only the summary line and errors");
@@ -363,11 +371,16 @@ int main(int argc, char** argv)
                 o.quality.samples = fromPreset.samples;
             if (app.count("--precision") == 0)
                 o.precision = fromPreset.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
+            if (app.count("--hexagon") == 0)
+                o.kernel = std::string(kernelName(fromPreset.kernel));
+            if (app.count("--near-field") == 0)
+                o.quality.nearField = fromPreset.nearField;
             o.halfResolution = preset(o.qualityPreset).settings.resolution == Resolution::Half;
         }
         o.quality.adaptive = !alwaysOn;
         o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
         o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
+        parseKernel(o.kernel, o.quality.kernel);
         bool autoFocus = false;
         if (!parseFocus(o.focus, o.lens, autoFocus)) {
             spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);

@@ -122,6 +122,12 @@ std::string shortLabel(const MethodInfo& info, const MethodSettings& s)
     std::string base;
     if (info.name == "mcintosh")
         base = fmt::format("M{}", s.samples);
+    else if (info.name == "mcintosh-near")
+        base = fmt::format("MN{}", s.samples);
+    else if (info.name == "rhombi")
+        base = fmt::format("H{}", s.samples);
+    else if (info.name == "rhombi-near")
+        base = fmt::format("HN{}", s.samples);
     else if (info.name == "riguer")
         base = "R12";
     else if (info.name == "lazy8")
@@ -200,6 +206,12 @@ cv::Scalar methodColour(std::string_view name)
 {
     if (name == "mcintosh")
         return {200, 110, 30}; // BGR
+    if (name == "mcintosh-near")
+        return {230, 170, 110};
+    if (name == "rhombi")
+        return {20, 170, 230};
+    if (name == "rhombi-near")
+        return {0, 90, 200};
     if (name == "riguer")
         return {40, 150, 40};
     if (name == "lazy8")
@@ -353,13 +365,16 @@ cv::Mat paretoPlot(const std::vector<Row>& rows, double unblurredDb)
     }
 
     // Legend.
-    int ly = area.y + area.height - 118;
+    int ly = area.y + area.height - 186;
     const int lx = area.x + area.width - 330;
     const cv::Rect legend(cv::Point(lx - 8, ly - 16), cv::Point(area.x + area.width - 4, area.y + area.height - 4));
     cv::rectangle(plot, legend, cv::Scalar(250, 250, 250), cv::FILLED);
     cv::rectangle(plot, legend, grid, 1);
     for (const auto& [name, text] :
          std::vector<std::pair<std::string, std::string>>{{"mcintosh", "M<n>: McIntosh, n taps per pass"},
+                                                          {"mcintosh-near", "MN<n>: McIntosh + near layer"},
+                                                          {"rhombi", "H<n>: rhombi sum, n taps per line"},
+                                                          {"rhombi-near", "HN<n>: rhombi + scatter as gather"},
                                                           {"riguer", "R12: Riguer 12-tap Poisson"},
                                                           {"lazy8", "L8: lazy 8-point"},
                                                           {"gaussian5x5", "G25: 5x5 Gaussian"},
@@ -748,8 +763,8 @@ int main(int argc, char** argv)
     app.add_option("--warmup", options.warmup, "unmeasured runs before them")
         ->check(CLI::Range(0, 100))
         ->capture_default_str();
-    app.add_option("--methods", methods, "comma-separated subset of: mcintosh,riguer,lazy8,gaussian5x5,reference,"
-                                         "reference-pointy (default: all)");
+    app.add_option("--methods", methods, "comma-separated subset of: mcintosh,mcintosh-near,rhombi,rhombi-near,riguer,"
+                                         "lazy8,gaussian5x5,reference,reference-pointy (default: all)");
     app.add_flag("--no-reference", options.noReference, "skip the CPU references (seconds each)");
     app.add_flag("--no-timers", options.noTimers, "no GL timer queries");
     app.add_option("--replot", options.replot, "only redraw --out/pareto.png from an earlier run's accuracy.json");

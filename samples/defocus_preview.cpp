@@ -348,7 +348,10 @@ int main(int argc, char** argv)
                    "focal-range model: near limit in metres at the starting focus (2 m with auto); it then follows "
                    "the focus in proportion [default: half the focus]");
     app.add_option("--far", o.farM, "focal-range model: far limit, likewise [default: 3 x the focus]");
-    app.add_option("--samples", o.quality.samples, "Taps per directional blur pass, 2..64")->capture_default_str();
+    app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64")->capture_default_str();
+    app.add_option("--blade-rotation", o.lens.bladeRotationDeg,
+                   "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top, 30 = flat top")
+        ->capture_default_str();
     std::vector<std::string> views;
     for (const View v : kAllViews)
         views.emplace_back(viewName(v));

@@ -47,10 +47,13 @@ TEST_F(Passes, PointLightBecomesAFlatTopHexagonOfThePredictedArea)
     color.at<cv::Vec3f>(size / 2, size / 2) = cv::Vec3f(1000.0f, 1000.0f, 1000.0f);
     Frame frame{color, cv::Mat(color.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "point"};
     QualitySettings quality;
+    quality.kernel = HexagonKernel::McIntoshMin;
     quality.samples = 48; // taps under one pixel apart, so the 1-px light is never skipped
     quality.targetFormat = TargetFormat::Rgba32F;
+    LensSettings lens = test::lensWithFarCoc(diameter);
+    lens.bladeRotationDeg = 30.0; // flat top, as in McIntosh et al.'s figures (first pass at 0 deg)
     Pipeline pipeline;
-    const cv::Mat out = pipeline.run(frame, test::lensWithFarCoc(diameter), quality, View::Composite, Encoding::Linear32F);
+    const cv::Mat out = pipeline.run(frame, lens, quality, View::Composite, Encoding::Linear32F);
     cv::Mat gray;
     cv::cvtColor(out, gray, cv::COLOR_BGR2GRAY);
 
@@ -94,6 +97,102 @@ TEST_F(Passes, PointLightBecomesAFlatTopHexagonOfThePredictedArea)
         }
 }
 
+// The rhombus kernel on one bright pixel: the hexagon itself, flat (every pixel inside gets the
+// same share of the light), of the predicted area, with all of the light kept, and oriented by
+// the blade rotation. `rotation` 0: a corner on top; 30: a flat edge on top.
+struct RhombusShape {
+    double area = 0, predicted = 0, energyRatio = 0, flatness = 0;
+    int topWidth = 0, width = 0, height = 0;
+};
+
+RhombusShape rhombusShape(double rotation, bool nearField)
+{
+    const int size = 121;
+    const double diameter = 40.0;
+    cv::Mat color(size, size, CV_32FC3, cv::Scalar::all(0.0));
+    color.at<cv::Vec3f>(size / 2, size / 2) = cv::Vec3f(1000.0f, 1000.0f, 1000.0f);
+    Frame frame{color, cv::Mat(color.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "point"};
+    QualitySettings quality;
+    quality.kernel = HexagonKernel::RhombiSum;
+    quality.samples = 32; // one tap per pixel along every line (radius 20 px)
+    quality.targetFormat = TargetFormat::Rgba32F;
+    quality.nearField = nearField;
+    LensSettings lens = test::lensWithFarCoc(diameter);
+    lens.bladeRotationDeg = rotation;
+    Pipeline pipeline;
+    const cv::Mat out = pipeline.run(frame, lens, quality, View::Composite, Encoding::Linear32F);
+    cv::Mat gray;
+    cv::cvtColor(out, gray, cv::COLOR_BGR2GRAY);
+
+    RhombusShape shape;
+    shape.energyRatio = cv::sum(gray)[0] / 1000.0;
+    shape.predicted = 3.0 * std::sqrt(3.0) / 8.0 * diameter * diameter;
+    // The plateau is 1000 spread evenly over the hexagon; its edges are soft (bilinear taps), and
+    // symmetric about half the plateau, so the area is measured there.
+    const cv::Mat lit = gray > 0.5 * 1000.0 / shape.predicted;
+    shape.area = cv::countNonZero(lit);
+    // Flatness: the spread of the values inside the hexagon shrunk by 3 px (away from the
+    // partly covered edge pixels), as a share of their mean.
+    const double c = size / 2, r = diameter / 2 - 3.0;
+    double lo = 1e30, hi = 0, sum = 0;
+    int n = 0;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            // Rotate into the frame where the corners sit at 0, 60, ... deg (a corner at the right).
+            const double a = (90.0 + rotation) * CV_PI / 180.0;
+            const double px = x - c, py = c - y;
+            const double dx = std::abs(px * std::cos(a) + py * std::sin(a));
+            const double dy = std::abs(-px * std::sin(a) + py * std::cos(a));
+            if (!(dy <= std::sqrt(3.0) / 2.0 * r && std::sqrt(3.0) * dx + dy <= std::sqrt(3.0) * r))
+                continue;
+            const double v = gray.at<float>(y, x);
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+            sum += v;
+            ++n;
+        }
+    shape.flatness = (hi - lo) / (sum / n);
+    const cv::Rect box = cv::boundingRect(lit);
+    shape.topWidth = cv::countNonZero(lit.row(box.y));
+    shape.width = box.width;
+    shape.height = box.height;
+    return shape;
+}
+
+TEST_F(Passes, RhombusKernelIsAFlatCornerUpHexagonThatKeepsAllTheLight)
+{
+    for (const bool near : {false, true}) {
+        const RhombusShape s = rhombusShape(0.0, near);
+        SCOPED_TRACE(near ? "near field" : "no near field");
+        // Energy: the three rhombi are disjoint and together the hexagon, each line a mean, so
+        // the light is redistributed, not lost (McIntosh's min() keeps about 3/4); 1 % for
+        // float rounding over ~1000 pixels.
+        EXPECT_NEAR(s.energyRatio, 1.0, 0.01);
+        // Flat: every inner pixel gets about the same share. Measured 0.42 of the mean from
+        // lowest to highest: 1-px seams where rhombi meet (-12 %/+13 % side by side) and +-7 %
+        // inside the third rhombus, whose line crosses another off-axis line (rhombus_blur.frag).
+        // Taps that make a digital line crossed by another (0 or 2 hits) measured 0.9 or more,
+        // McIntosh's min() peaks at the centre.
+        EXPECT_LT(s.flatness, 0.5);
+        // Area of the lit region: the hexagon of circumscribed diameter 40 px, within 10 %
+        // (its edges are whole pixels).
+        EXPECT_NEAR(s.area, s.predicted, 0.10 * s.predicted);
+        // A corner on top: the top row has a few pixels, the box is sqrt(3)/2 d wide and d high.
+        EXPECT_LE(s.topWidth, 5);
+        EXPECT_NEAR(s.width, std::sqrt(3.0) / 2.0 * 40.0, 3.0);
+        EXPECT_NEAR(s.height, 40.0, 3.0);
+    }
+}
+
+TEST_F(Passes, RhombusKernelFollowsTheBladeRotation)
+{
+    const RhombusShape s = rhombusShape(30.0, false);
+    EXPECT_NEAR(s.energyRatio, 1.0, 0.01);
+    EXPECT_GT(s.topWidth, 0.35 * 40.0); // a flat edge on top
+    EXPECT_NEAR(s.width, 40.0, 3.0);
+    EXPECT_NEAR(s.height, std::sqrt(3.0) / 2.0 * 40.0, 3.0);
+}
+
 TEST_F(Passes, ConstantDepthBlursUniformly)
 {
     // A fine checkerboard blurred far wider than its period is flat grey everywhere away from
@@ -110,7 +209,8 @@ TEST_F(Passes, ConstantDepthBlursUniformly)
     cv::meanStdDev(out(interior), mean, stddev);
     double lo = 0, hi = 0;
     cv::minMaxLoc(out(interior).reshape(1), &lo, &hi);
-    // min(A, B) of two averages of a 50 % pattern: a little under 0.5, the same everywhere.
+    // The default kernel averages a 50 % pattern to 0.5 (McIntosh's min() of two averages would
+    // give a little under), the same everywhere.
     EXPECT_NEAR(mean[0], 0.5, 0.06);
     EXPECT_LT(hi - lo, 0.08) << "the blur must not vary across the frame";
     std::vector<cv::Mat> channels;

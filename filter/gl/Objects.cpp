@@ -46,6 +46,20 @@ Framebuffer::Framebuffer(const Texture& texture, std::string_view name)
     label(GL_FRAMEBUFFER, id, name);
 }
 
+Framebuffer::Framebuffer(const Texture& first, const Texture& second, std::string_view name)
+    : width_(first.width()), height_(first.height())
+{
+    assert(first.width() == second.width() && first.height() == second.height());
+    GLuint id = 0;
+    glCreateFramebuffers(1, &id);
+    handle_ = Handle<deleteFramebuffer>(id);
+    glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, first.id(), 0);
+    glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT1, second.id(), 0);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(id, 2, buffers);
+    label(GL_FRAMEBUFFER, id, name);
+}
+
 void Framebuffer::bindForDraw() const
 {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, id());

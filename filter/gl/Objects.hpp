@@ -83,12 +83,15 @@ private:
     int height_ = 0;
 };
 
-/// A framebuffer with one colour attachment: the render target of one pass.
+/// A framebuffer with one or two colour attachments: the render target of one pass.
 class Framebuffer {
 public:
     Framebuffer() = default;
     /// Attaches `texture` (not owned; must outlive this framebuffer).
     Framebuffer(const Texture& texture, std::string_view name);
+    /// Attaches `first` and `second` as draw buffers 0 and 1 (outputs at locations 0 and 1);
+    /// both of the same size, not owned.
+    Framebuffer(const Texture& first, const Texture& second, std::string_view name);
 
     GLuint id() const { return handle_.id(); }
     explicit operator bool() const { return bool(handle_); }

@@ -10,7 +10,7 @@
 
 #include "filter/ColorSpace.hpp"
 #include "filter/methods/GatherMethods.hpp"
-#include "filter/methods/McIntoshMethod.hpp"
+#include "filter/methods/PipelineMethod.hpp"
 #include "filter/methods/ReferenceMethod.hpp"
 #include "filter/passes/CocPass.hpp"
 
@@ -37,8 +37,14 @@ std::string describe(const MethodInfo& info, const MethodSettings& settings)
 const std::vector<MethodInfo>& methodRegistry()
 {
     static const std::vector<MethodInfo> registry{
-        {"mcintosh", "McIntosh et al. 2012 hexagonal chain (0, +120, -120 deg blurs, min)", true,
+        {"mcintosh", "McIntosh et al. 2012 hexagonal chain (blurs along three edges, min)", true,
          {4, 8, 12, 16, 24, 32, 48, 64}, limits::kSamples[0], limits::kSamples[1]},
+        {"mcintosh-near", "the same with a blurred foreground layer over it", true, {8, 16, 32, 48},
+         limits::kSamples[0], limits::kSamples[1]},
+        {"rhombi", "three one-sided rhombi summed: flat hexagon, paper's bleeding rule", true, {4, 6, 8, 12, 16, 24},
+         limits::kSamples[0], limits::kSamples[1]},
+        {"rhombi-near", "the same, foreground counted by its own CoC (scatter as gather)", true,
+         {4, 6, 8, 12, 16, 24, 32}, limits::kSamples[0], limits::kSamples[1]},
         {"riguer", "Riguer et al. 2004 12-tap Poisson disc with their bleeding rule", true, {12}, 12, 12},
         {"lazy8", "8-point lazy gather with a blurriness-difference threshold", true, {8}, 8, 8},
         {"gaussian5x5", "5x5 Gaussian spread by |CoC| (distance from the plane in focus)", true, {25}, 25, 25},
@@ -54,11 +60,6 @@ const MethodInfo* findMethod(std::string_view name)
         if (info.name == name)
             return &info;
     return nullptr;
-}
-
-const MethodInfo& McIntoshMethod::info() const
-{
-    return *findMethod("mcintosh");
 }
 
 const MethodInfo& RiguerMethod::info() const
@@ -78,8 +79,8 @@ const MethodInfo& GaussianMethod::info() const
 
 std::unique_ptr<Method> createMethod(std::string_view name, bool timers)
 {
-    if (name == "mcintosh")
-        return std::make_unique<McIntoshMethod>(timers);
+    if (PipelineMethod::handles(name))
+        return std::make_unique<PipelineMethod>(name, timers);
     if (name == "riguer")
         return std::make_unique<RiguerMethod>(timers);
     if (name == "lazy8")

@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "filter/methods/McIntoshMethod.hpp"
+#include "filter/methods/PipelineMethod.hpp"
 
 namespace defocus {
 
@@ -58,7 +58,8 @@ const Preset& preset(std::string_view name)
 
 QualitySettings presetSettings(std::string_view name)
 {
-    return McIntoshMethod::quality(preset(name).settings);
+    const Preset& p = preset(name);
+    return PipelineMethod::quality(p.method, p.settings);
 }
 
 } // namespace defocus

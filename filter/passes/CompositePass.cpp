@@ -8,6 +8,7 @@ namespace defocus {
 CompositePass::CompositePass()
     : program_("fullscreen.vert", "composite.frag", kName),
       nearProgram_("fullscreen.vert", "composite.frag", "composite near", {"NEAR_FIELD 1"}),
+      sumProgram_("fullscreen.vert", "composite.frag", "composite sum", {"SUM 1"}),
       nearest_(GL_NEAREST, "composite nearest")
 {
 }
@@ -25,6 +26,15 @@ void CompositePass::run(const gl::Texture& diagonalA, const gl::Texture& diagona
     } else {
         program_.use();
     }
+    drawFullscreenTriangle();
+}
+
+void CompositePass::runSum(const gl::Texture& a, const gl::Texture& b, const gl::Framebuffer& target)
+{
+    target.bindForDraw();
+    bindTexture(0, a.id(), nearest_.id());
+    bindTexture(1, b.id(), nearest_.id());
+    sumProgram_.use();
     drawFullscreenTriangle();
 }
 

@@ -1,4 +1,5 @@
-// Pass 5: min() of the two diagonal blurs, the hexagon; optionally the foreground layer over it.
+// Pass 5: the hexagon from the two results of the last blur pass: min() of the McIntosh diagonal
+// blurs (optionally with the foreground layer over it), or the sum of the rhombus pass's pair.
 // Shader: composite.frag.
 #pragma once
 
@@ -14,10 +15,13 @@ public:
     /// `nearA`/`nearB`: the foreground layer's two diagonal blurs, or null without a near field.
     void run(const gl::Texture& diagonalA, const gl::Texture& diagonalB, const gl::Framebuffer& target,
              const gl::Texture* nearA = nullptr, const gl::Texture* nearB = nullptr);
+    /// (A + 2 B) / 3 of the second rhombus pass's targets (rhombus_blur.frag).
+    void runSum(const gl::Texture& a, const gl::Texture& b, const gl::Framebuffer& target);
 
 private:
     gl::Program program_;
     gl::Program nearProgram_; ///< NEAR_FIELD variant
+    gl::Program sumProgram_;  ///< SUM variant
     gl::Sampler nearest_;
 };
 

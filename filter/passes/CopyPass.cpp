@@ -5,12 +5,17 @@
 
 namespace defocus {
 
-CopyPass::CopyPass() : program_("tiles.vert", "copy.frag", kName), nearest_(GL_NEAREST, "copy nearest") {}
+CopyPass::CopyPass()
+    : program_("tiles.vert", "copy.frag", kName),
+      twoTargetProgram_("tiles.vert", "copy.frag", "copy two targets", {"TWO_TARGETS 1"}),
+      nearest_(GL_NEAREST, "copy nearest")
+{
+}
 
-void CopyPass::run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target)
+void CopyPass::run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target, bool twoTargets)
 {
     target.bindForDraw();
-    program_.use();
+    (twoTargets ? twoTargetProgram_ : program_).use();
     bindTexture(0, source.id(), nearest_.id());
     tiles.draw();
 }

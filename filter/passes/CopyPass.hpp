@@ -11,10 +11,13 @@ class CopyPass {
 public:
     static constexpr const char* kName = "copy";
     CopyPass();
-    void run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target);
+    /// Copies `source` into `target`'s attachments on `tiles`: the first, or with `twoTargets`
+    /// both (the rhombus passes' pair of targets).
+    void run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target, bool twoTargets = false);
 
 private:
     gl::Program program_;
+    gl::Program twoTargetProgram_;
     gl::Sampler nearest_;
 };
 

@@ -1,0 +1,30 @@
+// The filter's own chains (defocus::Pipeline) as registry entries: "mcintosh" (McIntosh et al.
+// 2012, min() of two rhombi), "rhombi" (three one-sided rhombi summed), each also with its
+// foreground handling ("-near"). QualitySettings come from the method name and settings.
+#pragma once
+
+#include <string_view>
+
+#include "filter/Pipeline.hpp"
+#include "filter/methods/Method.hpp"
+
+namespace defocus {
+
+class PipelineMethod final : public Method {
+public:
+    /// `name`: mcintosh, mcintosh-near, rhombi or rhombi-near.
+    PipelineMethod(std::string_view name, bool timers);
+    const MethodInfo& info() const override { return info_; }
+    /// The QualitySettings the pipeline runs with for method `name`: kernel and near field from
+    /// the name, samples and precision from `settings`, adaptive tiles on (what users get).
+    /// Throws std::invalid_argument for a name that is not one of the four.
+    static QualitySettings quality(std::string_view name, const MethodSettings& settings);
+    static bool handles(std::string_view name);
+
+private:
+    MethodResult process(const Frame& frame, const LensSettings& lens, const MethodSettings& settings) override;
+    const MethodInfo& info_;
+    Pipeline pipeline_;
+};
+
+} // namespace defocus

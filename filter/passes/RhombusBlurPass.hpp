@@ -1,0 +1,69 @@
+// One pass of the energy-conserving hexagon: three one-sided rhombi summed (shader
+// rhombus_blur.frag, where the decomposition is derived). Two passes and a composite make the
+// hexagon; each pass writes two targets.
+#pragma once
+
+#include <array>
+
+#include "filter/gl/Objects.hpp"
+#include "filter/gl/Program.hpp"
+#include "filter/passes/TileList.hpp"
+
+namespace defocus {
+
+class RhombusBlurPass {
+public:
+    /// Taps per line at most. Lines take one tap per pixel of their length up to `taps`;
+    /// longer ones space `taps` taps out evenly.
+    static constexpr int kMaxTaps = 64;
+    /// The paper's bleeding rule fades in over this much CoC around its threshold (pixels), so
+    /// that it does not switch on depth noise. In pixels, not the paper's unit (a fraction of
+    /// the image height): a frame one pixel high would otherwise switch within 0.01 px.
+    static constexpr float kBleedingRampPx = 4.0f;
+
+    /// The directions of one hexagon, degrees counter-clockwise on screen: u1 towards the corner
+    /// nearest an axis, u2 = u1 + 120, u3 = u1 + 240. `bladeRotationDeg` 0 puts a corner on top
+    /// (u1 = 90); 30 a flat edge (u1 = 0).
+    struct Directions {
+        float u1, u2, u3;
+    };
+    static Directions directions(float bladeRotationDeg);
+
+    /// What a pass reads and writes. Pass 1 reads `sourceA` (the CoC target) and writes X, Y;
+    /// pass 2 reads X as `sourceA` and Y as `sourceB` and writes A, B.
+    struct Io {
+        const gl::Texture& sourceA;
+        const gl::Texture* sourceB; ///< pass 2 only
+        /// Per tile: the largest foreground CoC diameter that can reach it (pixels, R32F);
+        /// nullptr: no near field (lines as long as the centre's own radius).
+        const gl::Texture* nearDiameter;
+        const gl::Framebuffer& target; ///< two colour attachments
+    };
+
+    RhombusBlurPass();
+    /// `first`: pass 1 (lines u1 and u2 of the CoC target) or pass 2 (u2 of X, u3 of Y).
+    /// `taps`: most taps per line. With `tiles`, only those tiles are drawn.
+    void run(const Io& io, bool first, const Directions& directions, int taps, int tileSize,
+             const TileList* tiles = nullptr);
+
+private:
+    /// Mirrors the std140 block RhombusBlurParams in rhombus_blur.frag.
+    struct Uniforms {
+        float directions[4];
+        float across[4];
+        float baseSteps[2]; ///< std140: the ints follow the vec2 directly
+        int maxTaps;
+        int nearTileSize;
+        float bleedingBias;
+        float bleedingMult;
+        float cocToPaperUnits;
+        float bleedingRamp;
+    };
+    /// One program per variant: [first pass][near field][tiles], tiles on tiles.vert.
+    std::array<std::array<std::array<gl::Program, 2>, 2>, 2> programs_;
+    gl::UniformBuffer uniforms_;
+    gl::Sampler linear_;
+    gl::Sampler nearest_;
+};
+
+} // namespace defocus

@@ -1,0 +1,161 @@
+#version 450 core
+// Energy-conserving hexagon from three one-sided rhombi. A regular hexagon of circumradius R is
+// the union of three rhombi that share its centre, each spanned by two of the three unit vectors
+// u1, u2, u3 (120 deg apart, towards alternate corners), and each rhombus is the convolution of
+// two one-sided segments [0, R]·ui. With L_i the mean along [0, R]·u_i:
+//
+//   hexagon = (L1 L2 + L2 L3 + L3 L1) / 3 = (L2 (L1 s) + 2 L3 ((L1 s + L2 s) / 2)) / 3
+//
+//   pass 1 (FIRST): X = L1 s, Y = (X + L2 s) / 2            -> two targets
+//   pass 2:         A = L2 X, B = L3 Y                       -> two targets
+//   composite:      (A + 2 B) / 3
+//
+// Unlike the min() of McIntosh et al. 2012 (hex_blur.frag), the kernel is flat: a highlight
+// keeps all of its energy and texture is not darkened. Each line reads half the distance of a
+// centred segment, so the same tap spacing takes half the taps. The sign convention follows
+// hex_blur.frag: a counter-clockwise screen angle moves towards smaller v.
+//
+// Nearer or farther: signed CoC grows with depth through the focus plane (both CoC models), so
+// comparing the taps' CoC orders them as depth would, without a depth fetch per tap.
+//
+// Bleeding: a tap nearer than the centre and sharper than it is weighted by its blurriness as in
+// the paper (bleedingBias/bleedingMult). NEAR_FIELD, "scatter as gather" (Jimenez 2014): each
+// line reaches as far as the largest foreground blur that can reach this pixel (tile maxima
+// dilated on the CPU); a nearer tap that is blurrier than the centre counts where its own radius
+// reaches the centre, with the coverage a scattered segment of its length would give, and lies
+// over the centre's own blur by that coverage. FIRST_PASS and NEAR_FIELD are compile-time
+// variants: llvmpipe pays for every instruction of a branch on a uniform.
+
+layout(location = 0) in vec2 vUv;
+layout(location = 0) out vec4 outFirst;
+layout(location = 1) out vec4 outSecond;
+
+// Each line reads its texture through two units: its own sampler (unfiltered or bilinear, see
+// RhombusBlurPass::run) and a bilinear one for spread taps.
+layout(binding = 0) uniform sampler2D uLine1;        // pass 1: rgb + signed CoC (px); pass 2: X
+layout(binding = 1) uniform sampler2D uLine1Smooth;
+layout(binding = 2) uniform sampler2D uNearDiameter; // per tile, pixels (NEAR_FIELD only)
+layout(binding = 3) uniform sampler2D uLine2;        // pass 1: the CoC target again; pass 2: Y
+layout(binding = 4) uniform sampler2D uLine2Smooth;
+
+layout(std140, binding = 0) uniform RhombusBlurParams {
+    vec4 directions;       // xy, zw: texture-space offset per pixel along this pass's two lines
+    vec4 across;           // pass 2: texture-space offset half a pixel across each line, or 0
+    vec2 baseSteps;        // pixels: the step of each line that moves one pixel on its major axis
+    int maxTaps;           // taps per line at most
+    int nearTileSize;      // pixels per tile of uNearDiameter
+    float bleedingBias;    // the paper's unit: CoC as a fraction of the image height
+    float bleedingMult;
+    float cocToPaperUnits; // 1 / image height in pixels
+    float bleedingRamp;    // width of the bleeding rule's fade, the paper's unit
+};
+
+// The mean along a one-sided segment of length `extent` from this pixel in `direction`, in
+// pieces one step long: the centre covers [0, 1/2], tap k >= 1 covers [k - 1/2, k + 1/2] steps,
+// and the last piece counts by the part of it inside the segment. The base step moves exactly one
+// pixel along the line's major axis (baseStep = 1 / max(|cos|, |sin|) pixels), so successive taps
+// sit in successive columns (or rows). A segment shorter than half a step is the centre alone
+// (|CoC| < 1 px leaves a pixel as it is), and the result moves continuously with the CoC: taps
+// sit at fixed offsets and only their weights change. Lines longer than maxTaps base steps space
+// the taps out; those taps move with the CoC and are always filtered (the `smooth` samplers).
+// Unfiltered taps off the axes make digital lines, and a second line off the axes crossing a
+// digital line hits it twice or never: a point light's hexagon came out striped. Lines that are
+// crossed that way later, and lines that cross them, take bilinear taps. Bilinear taps do not
+// cure it where both lines are off the axes (the third rhombus, u3 of u2): crossing a bilinear
+// line obliquely still depends on where it lies between texel centres (+-44 % on a point light,
+// measured with a CPU model of this shader). A pass-2 line over a pass-1 line, both off the axes
+// (`across` != 0), takes each tap as the mean of two, half a pixel to either side of it: +-8 %.
+vec3 line(sampler2D source, sampler2D smoothSource, vec2 direction, float baseStep, vec2 across, vec4 center,
+          float extent)
+{
+    const float radius = 0.5 * abs(center.a);
+    const float centerBlur = abs(center.a) * cocToPaperUnits;
+    const float step = max(baseStep, extent / float(maxTaps));
+    const float length = extent / step;       // in steps
+    const float ownLength = radius / step;    // the centre's own blur, in steps
+    const int taps = int(ceil(length - 0.5)); // pieces k >= 1 that start inside the segment
+    // Spread taps leave the lattice and are filtered; the switch fades over the first quarter
+    // of a step so that the output stays continuous in the CoC.
+    const float smoothing = clamp((step / baseStep - 1.0) * 4.0, 0.0, 1.0);
+
+    float backgroundWeight = min(ownLength, 0.5);
+    vec3 background = center.rgb * backgroundWeight;
+#ifdef NEAR_FIELD
+    vec3 foreground = vec3(0.0);
+    float coverage = 0.0;
+#endif
+    for (int k = 1; k <= taps; ++k) {
+        const float distance = float(k) * step;
+        const vec2 coords = vUv + direction * distance;
+        vec4 tap;
+        if (across != vec2(0.0))
+            tap = 0.5 * (textureLod(smoothSource, coords + across, 0.0) + textureLod(smoothSource, coords - across, 0.0));
+        else if (smoothing == 0.0)
+            tap = textureLod(source, coords, 0.0);
+        else if (smoothing == 1.0)
+            tap = textureLod(smoothSource, coords, 0.0);
+        else
+            tap = mix(textureLod(source, coords, 0.0), textureLod(smoothSource, coords, 0.0), smoothing);
+        const bool nearer = tap.a < center.a;
+        const float tapBlur = abs(tap.a) * cocToPaperUnits;
+        // The centre's own blur, with the paper's bleeding rule, faded in over a bleedingRamp
+        // around its threshold instead of switched: depth noise at the threshold would make the
+        // pixel flicker (a tap may carry most of a short line's weight).
+        const float rule = nearer ? clamp(tapBlur * bleedingMult, 0.0, 1.0) : 1.0;
+        float weight = mix(1.0, rule, clamp((centerBlur - tapBlur - bleedingBias) / bleedingRamp + 0.5, 0.0, 1.0));
+        weight *= clamp(ownLength - float(k) + 0.5, 0.0, 1.0);
+#ifdef NEAR_FIELD
+        // Foreground that reaches: soft over the last half pixel of its radius; a segment of
+        // length tapRadius scattered from the tap puts step / tapRadius of it on this pixel.
+        const float tapRadius = 0.5 * abs(tap.a);
+        const float reach = nearer && tapRadius > radius
+                                ? clamp(tapRadius - distance + 0.5, 0.0, 1.0) * clamp(length - float(k) + 0.5, 0.0, 1.0)
+                                : 0.0;
+        const float share = reach * step / max(tapRadius, 1e-3);
+        foreground += tap.rgb * share;
+        coverage += share;
+        weight *= 1.0 - reach;
+#endif
+        background += tap.rgb * weight;
+        backgroundWeight += weight;
+    }
+    // The bleeding rule may reject every tap: the centre stays (its weight is > 0 whenever the
+    // centre has a blur of its own; without one, the background is the centre).
+    background = backgroundWeight > 0.0 ? background / backgroundWeight : center.rgb;
+#ifdef NEAR_FIELD
+    const float alpha = clamp(coverage, 0.0, 1.0);
+    return alpha * (foreground / max(coverage, 1e-6)) + (1.0 - alpha) * background;
+#else
+    return background;
+#endif
+}
+
+void main()
+{
+    const ivec2 texel = ivec2(gl_FragCoord.xy);
+    const vec4 center = texelFetch(uLine1, texel, 0);
+    float extent = 0.5 * abs(center.a);
+#ifdef NEAR_FIELD
+    extent = max(extent, 0.5 * texelFetch(uNearDiameter, texel / nearTileSize, 0).r);
+#endif
+#ifdef FIRST_PASS
+    const vec4 centerB = center;
+#else
+    const vec4 centerB = texelFetch(uLine2, texel, 0);
+#endif
+    // In focus (|CoC| < 1 px) and out of any foreground's reach: the pixel stays, bit-exact.
+    if (extent < 0.5) {
+        outFirst = center;
+        outSecond = centerB;
+        return;
+    }
+#ifdef FIRST_PASS
+    const vec3 x = line(uLine1, uLine1Smooth, directions.xy, baseSteps.x, vec2(0.0), center, extent);
+    outFirst = vec4(x, center.a);
+    outSecond = vec4(0.5 * (x + line(uLine2, uLine2Smooth, directions.zw, baseSteps.y, vec2(0.0), center, extent)),
+                     center.a);
+#else
+    outFirst = vec4(line(uLine1, uLine1Smooth, directions.xy, baseSteps.x, across.xy, center, extent), center.a);
+    outSecond = vec4(line(uLine2, uLine2Smooth, directions.zw, baseSteps.y, across.zw, centerB, extent), center.a);
+#endif
+}
