@@ -30,8 +30,7 @@ layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outFirst;
 layout(location = 1) out vec4 outSecond;
 
-// Each line reads its texture through two units: its own sampler (unfiltered or bilinear, see
-// RhombusBlurPass::run) and a bilinear one for spread taps.
+// Each line reads its texture through two units: unfiltered and bilinear.
 layout(binding = 0) uniform sampler2D uLine1;        // pass 1: rgb + signed CoC (px); pass 2: X
 layout(binding = 1) uniform sampler2D uLine1Smooth;
 layout(binding = 2) uniform sampler2D uNearDiameter; // per tile, pixels (NEAR_FIELD only)
@@ -64,9 +63,15 @@ layout(std140, binding = 0) uniform RhombusBlurParams {
 // cure it where both lines are off the axes (the third rhombus, u3 of u2): crossing a bilinear
 // line obliquely still depends on where it lies between texel centres (+-44 % on a point light,
 // measured with a CPU model of this shader). A pass-2 line over a pass-1 line, both off the axes
-// (`across` != 0), takes each tap as the mean of two, half a pixel to either side of it: +-8 %.
-vec3 line(sampler2D source, sampler2D smoothSource, vec2 direction, float baseStep, vec2 across, vec4 center,
-          float extent)
+// (PAIR), takes each tap as the mean of two, half a pixel to either side of it: +-8 %.
+// `mode` is a compile-time constant per line (LINE1_MODE, LINE2_MODE, set by RhombusBlurPass):
+// llvmpipe runs both sides of a branch that differs between pixels, so a run-time choice cost
+// every tap all of its fetches.
+const int POINT = 0;  // unfiltered (bilinear only for spread taps)
+const int SMOOTH = 1; // bilinear
+const int PAIR = 2;   // two bilinear taps, `across` to either side
+vec3 line(sampler2D source, sampler2D smoothSource, const int mode, vec2 direction, float baseStep, vec2 across,
+          vec4 center, float extent)
 {
     const float radius = 0.5 * abs(center.a);
     const float centerBlur = abs(center.a) * cocToPaperUnits;
@@ -88,14 +93,15 @@ vec3 line(sampler2D source, sampler2D smoothSource, vec2 direction, float baseSt
         const float distance = float(k) * step;
         const vec2 coords = vUv + direction * distance;
         vec4 tap;
-        if (across != vec2(0.0))
+        if (mode == PAIR) {
             tap = 0.5 * (textureLod(smoothSource, coords + across, 0.0) + textureLod(smoothSource, coords - across, 0.0));
-        else if (smoothing == 0.0)
-            tap = textureLod(source, coords, 0.0);
-        else if (smoothing == 1.0)
+        } else if (mode == SMOOTH) {
             tap = textureLod(smoothSource, coords, 0.0);
-        else
-            tap = mix(textureLod(source, coords, 0.0), textureLod(smoothSource, coords, 0.0), smoothing);
+        } else {
+            tap = textureLod(source, coords, 0.0);
+            if (smoothing > 0.0)
+                tap = mix(tap, textureLod(smoothSource, coords, 0.0), smoothing);
+        }
         const bool nearer = tap.a < center.a;
         const float tapBlur = abs(tap.a) * cocToPaperUnits;
         // The centre's own blur, with the paper's bleeding rule, faded in over a bleedingRamp
@@ -150,12 +156,15 @@ void main()
         return;
     }
 #ifdef FIRST_PASS
-    const vec3 x = line(uLine1, uLine1Smooth, directions.xy, baseSteps.x, vec2(0.0), center, extent);
+    const vec3 x = line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent);
     outFirst = vec4(x, center.a);
-    outSecond = vec4(0.5 * (x + line(uLine2, uLine2Smooth, directions.zw, baseSteps.y, vec2(0.0), center, extent)),
-                     center.a);
+    outSecond = vec4(
+        0.5 * (x + line(uLine2, uLine2Smooth, LINE2_MODE, directions.zw, baseSteps.y, across.zw, center, extent)),
+        center.a);
 #else
-    outFirst = vec4(line(uLine1, uLine1Smooth, directions.xy, baseSteps.x, across.xy, center, extent), center.a);
-    outSecond = vec4(line(uLine2, uLine2Smooth, directions.zw, baseSteps.y, across.zw, centerB, extent), center.a);
+    outFirst = vec4(line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent),
+                    center.a);
+    outSecond = vec4(line(uLine2, uLine2Smooth, LINE2_MODE, directions.zw, baseSteps.y, across.zw, centerB, extent),
+                     center.a);
 #endif
 }

@@ -44,24 +44,52 @@ bool alongAxis(float degrees)
 
 } // namespace
 
+/// The tap mode of pass 1's two lines and pass 2's two lines, in that order. A line crossed later
+/// by a line along another off-axis direction must be smooth (bilinear); a line crossing such a
+/// line takes the bilinear pair (rhombus_blur.frag). Lines on an axis, and lines crossing only
+/// an axis line, are exact with unfiltered taps.
+std::array<RhombusBlurPass::LineMode, 4> RhombusBlurPass::lineModes(const Directions& d)
+{
+    const bool axis1 = alongAxis(d.u1), axis2 = alongAxis(d.u2), axis3 = alongAxis(d.u3);
+    return {
+        axis1 ? LineMode::Point : LineMode::Smooth,               // u1 of the source: X, crossed by u2 and u3
+        axis2 ? LineMode::Point : LineMode::Smooth,               // u2 of the source: in Y, crossed by u3
+        axis1 || axis2 ? LineMode::Point : LineMode::Pair,        // u2 over X
+        axis3 ? LineMode::Point : (axis1 && axis2 ? LineMode::Smooth : LineMode::Pair), // u3 over Y
+    };
+}
+
 RhombusBlurPass::RhombusBlurPass()
     : uniforms_(sizeof(Uniforms), "rhombus blur params"),
       linear_(GL_LINEAR, "rhombus blur linear"),
       nearest_(GL_NEAREST, "rhombus blur nearest")
 {
-    for (const bool first : {false, true})
+    // The variants of the default rotation (a corner on top), so that no frame pays for them.
+    const auto modes = lineModes(directions(0.0f));
+    for (const bool first : {true, false})
         for (const bool near : {false, true})
-            for (const bool tiles : {false, true}) {
-                std::vector<std::string> defines;
-                if (first)
-                    defines.emplace_back("FIRST_PASS 1");
-                if (near)
-                    defines.emplace_back("NEAR_FIELD 1");
-                const std::string name = fmt::format("rhombus_blur{}{}{}", first ? " first" : " second",
-                                                     near ? " near" : "", tiles ? " tiles" : "");
-                programs_[first][near][tiles] =
-                    gl::Program(tiles ? "tiles.vert" : "fullscreen.vert", "rhombus_blur.frag", name, defines);
-            }
+            for (const bool tiles : {false, true})
+                program(first, near, tiles, modes[first ? 0 : 2], modes[first ? 1 : 3]);
+}
+
+const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, LineMode line1, LineMode line2)
+{
+    const int key = (first ? 1 : 0) | (near ? 2 : 0) | (tiles ? 4 : 0) | static_cast<int>(line1) << 3 |
+                    static_cast<int>(line2) << 5;
+    gl::Program& slot = programs_[key];
+    if (slot.id() == 0) {
+        std::vector<std::string> defines{fmt::format("LINE1_MODE {}", static_cast<int>(line1)),
+                                         fmt::format("LINE2_MODE {}", static_cast<int>(line2))};
+        if (first)
+            defines.emplace_back("FIRST_PASS 1");
+        if (near)
+            defines.emplace_back("NEAR_FIELD 1");
+        const std::string name = fmt::format("rhombus_blur{}{}{} {}{}", first ? " first" : " second",
+                                             near ? " near" : "", tiles ? " tiles" : "", static_cast<int>(line1),
+                                             static_cast<int>(line2));
+        slot = gl::Program(tiles ? "tiles.vert" : "fullscreen.vert", "rhombus_blur.frag", name, defines);
+    }
+    return slot;
 }
 
 RhombusBlurPass::Directions RhombusBlurPass::directions(float bladeRotationDeg)
@@ -92,23 +120,12 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
     Uniforms u{};
     step(line1, width, height, &u.directions[0], u.baseSteps[0]);
     step(line2, width, height, &u.directions[2], u.baseSteps[1]);
-    // Which lines need filtered taps. A line crossed later by a line along another off-axis
-    // direction must be smooth (bilinear); a line crossing such a line needs bilinear taps and
-    // the pair across it (rhombus_blur.frag). Lines on an axis, and lines crossing an axis line,
-    // are exact with unfiltered taps, which on llvmpipe cost a quarter of a bilinear one.
-    const bool axis1 = alongAxis(d.u1), axis2 = alongAxis(d.u2), axis3 = alongAxis(d.u3);
-    bool smooth1 = false, smooth2 = false;
-    if (first) {
-        smooth1 = !axis1; // X: crossed by u2 and u3
-        smooth2 = !axis2; // u2 in Y: crossed by u3
-    } else {
-        smooth1 = !(axis1 || axis2); // u2 over X
-        smooth2 = !axis3;            // u3 over Y, which holds lines along u1 and u2
-        if (smooth1)
-            halfPixelAcross(line1, width, height, &u.across[0]);
-        if (smooth2 && !(axis1 && axis2))
-            halfPixelAcross(line2, width, height, &u.across[2]);
-    }
+    const auto modes = lineModes(d);
+    const LineMode mode1 = modes[first ? 0 : 2], mode2 = modes[first ? 1 : 3];
+    if (mode1 == LineMode::Pair)
+        halfPixelAcross(line1, width, height, &u.across[0]);
+    if (mode2 == LineMode::Pair)
+        halfPixelAcross(line2, width, height, &u.across[2]);
     u.maxTaps = taps;
     u.nearTileSize = tileSize;
     u.bleedingBias = HexBlurPass::kBleedingBias;
@@ -120,13 +137,13 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
 
     io.target.bindForDraw();
     const gl::Texture& second = first ? io.sourceA : *io.sourceB;
-    bindTexture(0, io.sourceA.id(), (smooth1 ? linear_ : nearest_).id());
+    bindTexture(0, io.sourceA.id(), nearest_.id());
     bindTexture(1, io.sourceA.id(), linear_.id());
-    bindTexture(3, second.id(), (smooth2 ? linear_ : nearest_).id());
+    bindTexture(3, second.id(), nearest_.id());
     bindTexture(4, second.id(), linear_.id());
     if (io.nearDiameter)
         bindTexture(2, io.nearDiameter->id(), nearest_.id());
-    programs_[first][io.nearDiameter != nullptr][tiles != nullptr].use();
+    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2).use();
     if (tiles)
         tiles->draw();
     else

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
@@ -59,8 +60,12 @@ private:
         float cocToPaperUnits;
         float bleedingRamp;
     };
-    /// One program per variant: [first pass][near field][tiles], tiles on tiles.vert.
-    std::array<std::array<std::array<gl::Program, 2>, 2>, 2> programs_;
+    /// How a line takes its taps (rhombus_blur.frag): unfiltered, bilinear, or a bilinear pair.
+    enum class LineMode { Point = 0, Smooth = 1, Pair = 2 };
+    static std::array<LineMode, 4> lineModes(const Directions& directions);
+    /// The program of one variant, compiled on first use: pass, near field, tiles, line modes.
+    const gl::Program& program(bool first, bool near, bool tiles, LineMode line1, LineMode line2);
+    std::map<int, gl::Program> programs_;
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
     gl::Sampler nearest_;
