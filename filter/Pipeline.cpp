@@ -220,6 +220,8 @@ void Pipeline::Impl::prepareDepthAndPlan()
     analysis = analyseScene(prepared.metres, color, coefficients, prepared.invalidFraction);
     const bool allInFocus = plan.allInFocus && quality.adaptive;
     plan = makePlan(analysis, quality.nearField, quality.kernel);
+    if (color.type() == CV_8UC3 && plan.highlights && !plan.allInFocus)
+        plan.highlightGain = quality.highlightGain;
     plan.allInFocus = plan.allInFocus || allInFocus;
 }
 
@@ -325,7 +327,8 @@ void Pipeline::Impl::render()
     }
     glBindVertexArray(vao.id());
     timer.begin(CocPass::kName);
-    cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer);
+    // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
+    cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain));
     timer.end();
     if (quality.kernel == HexagonKernel::RhombiSum)
         renderRhombi(useTiles);

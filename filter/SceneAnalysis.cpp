@@ -125,6 +125,8 @@ std::string FramePlan::explain(const SceneAnalysis& analysis) const
     text += nearField ? fmt::format("; near field on {} tiles", nearTiles.size())
                       : foreground ? "; foreground blur, near field off" : "; no foreground blur, near field off";
     text += highlights ? fmt::format("; highlights {:.2f} %", 100.0 * analysis.highlightFraction) : "; no highlights";
+    if (highlightGain > 1.0)
+        text += fmt::format(" (recovered x{:g})", highlightGain);
     return text;
 }
 

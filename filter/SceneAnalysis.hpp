@@ -52,6 +52,8 @@ struct FramePlan {
     bool nearField = false;           ///< the foreground layer passes run
     std::vector<cv::Point> nearTiles; ///< tiles the foreground layer covers
     HexagonKernel kernel = HexagonKernel::McIntoshMin; ///< the blur passes' kind, for explain()
+    /// Gain of the 8-bit highlight recovery in the CoC pass; 1 = not run (set by the pipeline).
+    double highlightGain = 1.0;
 
     /// One line for --explain, e.g. "blur 812/1200 tiles, copy 388; hole fill on (24.1 % invalid)".
     std::string explain(const SceneAnalysis& analysis) const;

@@ -87,6 +87,8 @@ std::vector<SettingIssue> validate(QualitySettings& quality, bool clamp)
 {
     std::vector<SettingIssue> issues;
     checkRange(issues, "--samples", quality.samples, limits::kSamples[0], limits::kSamples[1], clamp);
+    checkRange(issues, "--highlight-gain", quality.highlightGain, limits::kHighlightGain[0], limits::kHighlightGain[1],
+               clamp);
     return issues;
 }
 

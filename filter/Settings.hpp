@@ -77,6 +77,11 @@ struct QualitySettings {
     /// reach the pixel, and foreground taps count by their own CoC. Runs only on frames, and
     /// tiles, with foreground blur.
     bool nearField = false;
+    /// Highlights from 8-bit input, [1, 64]: near-clipped pixels (any channel >= 0.96 linear)
+    /// that get blurred are scaled up to this gain, so that lights in ordinary video bloom into
+    /// bright hexagons. 1 = off (the default). Runs only on frames with clipped pixels; float
+    /// input keeps its own HDR values.
+    double highlightGain = 1.0;
 };
 
 /// What the pipeline writes out. The first five are the McIntosh lab's modes 1-5.
@@ -124,6 +129,7 @@ inline constexpr double kSensorWidthMm[] = {1.0, 100.0};
 inline constexpr double kMaxCocPx[] = {0.0, 512.0};
 inline constexpr double kBladeRotationDeg[] = {-180.0, 180.0};
 inline constexpr int kSamples[] = {2, 64};
+inline constexpr double kHighlightGain[] = {1.0, 64.0};
 } // namespace limits
 
 } // namespace defocus

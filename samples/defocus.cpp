@@ -343,6 +343,9 @@ int main(int argc, char** argv)
     app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
     app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
     bool alwaysOn = false;
+    app.add_option("--highlight-gain", o.quality.highlightGain,
+                   "8-bit input: scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
+        ->capture_default_str();
     app.add_flag("--near-field,!--no-near-field", o.quality.nearField,
                  "Spread blurred foreground over what is behind it [default: from --quality]");
     app.add_flag("--always-on", alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");

@@ -349,6 +349,9 @@ int main(int argc, char** argv)
                    "the focus in proportion [default: half the focus]");
     app.add_option("--far", o.farM, "focal-range model: far limit, likewise [default: 3 x the focus]");
     app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64")->capture_default_str();
+    app.add_option("--highlight-gain", o.quality.highlightGain,
+                   "Scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
+        ->capture_default_str();
     app.add_option("--blade-rotation", o.lens.bladeRotationDeg,
                    "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top, 30 = flat top")
         ->capture_default_str();

@@ -17,7 +17,21 @@ layout(std140, binding = 0) uniform CocParams {
     float maxCocPx;
     int inverseDepth;
     float largestColor; // 65504 for half-float targets
+    float highlightGain; // 8-bit input: near-clipped pixels that get blurred are scaled up to this
 };
+
+// Highlights from 8-bit video (issue 6): a light clipped at 255 is far brighter than 1.0, and a
+// blur of its clipped value spreads a dull grey. Pixels whose brightest channel is within the
+// top 4 % of the range are scaled up towards highlightGain, smoothly from 0.96 to 1.0 (linear),
+// so that lights bloom into bright polygons; only where the pixel will be blurred (|CoC| >= 1 px),
+// so that pixels in focus stay as they are.
+vec3 recoverHighlight(vec3 color, float coc)
+{
+    if (highlightGain <= 1.0 || abs(coc) < 1.0)
+        return color;
+    const float peak = max(color.r, max(color.g, color.b));
+    return color * mix(1.0, highlightGain, smoothstep(0.96, 1.0, peak));
+}
 
 void main()
 {
@@ -27,5 +41,5 @@ void main()
     const float x = inverseDepth != 0 ? 1.0 / z : z;
     const vec2 k = z < focusM ? coefficients.xy : coefficients.zw;
     const float coc = clamp(k.x * x + k.y, -maxCocPx, maxCocPx);
-    outColor = vec4(sanitizeColor(color, largestColor), coc);
+    outColor = vec4(sanitizeColor(recoverHighlight(color, coc), largestColor), coc);
 }

@@ -30,13 +30,14 @@ float CocPass::largestColor(bool halfTarget)
 }
 
 void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-                  const gl::Framebuffer& target)
+                  const gl::Framebuffer& target, float highlightGain)
 {
     const Uniforms u{{k.nearScale, k.nearOffset, k.farScale, k.farOffset},
                      k.focusM,
                      k.maxCocPx,
                      k.inverseDepth ? 1 : 0,
-                     largestColor(halfTarget)};
+                     largestColor(halfTarget),
+                     highlightGain};
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();

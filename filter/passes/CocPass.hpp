@@ -15,8 +15,9 @@ public:
     static float largestColor(bool halfTarget);
     /// `color`: sRGB8 or float RGB; `depth`: R32F metres with no holes; `halfTarget` keeps HDR
     /// colour below the half-float maximum.
+    /// `highlightGain` > 1 scales near-clipped pixels of 8-bit input that get blurred (coc.frag).
     void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-             const gl::Framebuffer& target);
+             const gl::Framebuffer& target, float highlightGain = 1.0f);
 
 private:
     /// Mirrors the std140 block CocParams in coc.frag.
@@ -26,6 +27,7 @@ private:
         float maxCocPx;
         int inverseDepth;
         float largestColor;
+        float highlightGain;
     };
     gl::Program program_;
     gl::UniformBuffer uniforms_;
