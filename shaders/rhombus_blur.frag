@@ -41,7 +41,7 @@ layout(std140, binding = 0) uniform RhombusBlurParams {
     vec4 directions;       // xy, zw: texture-space offset per pixel along this pass's two lines
     vec4 across;           // pass 2: texture-space offset half a pixel across each line, or 0
     vec2 baseSteps;        // pixels: the step of each line that moves one pixel on its major axis
-    int maxTaps;           // taps per line at most
+    int unusedMaxTaps;     // MAX_TAPS is a #define of the program variant
     int nearTileSize;      // pixels per tile of uNearDiameter
     float bleedingBias;    // the paper's unit: CoC as a fraction of the image height
     float bleedingMult;
@@ -75,7 +75,7 @@ vec3 line(sampler2D source, sampler2D smoothSource, const int mode, vec2 directi
 {
     const float radius = 0.5 * abs(center.a);
     const float centerBlur = abs(center.a) * cocToPaperUnits;
-    const float step = max(baseStep, extent / float(maxTaps));
+    const float step = max(baseStep, extent / float(MAX_TAPS));
     const float length = extent / step;       // in steps
     const float ownLength = radius / step;    // the centre's own blur, in steps
     const int taps = int(ceil(length - 0.5)); // pieces k >= 1 that start inside the segment
@@ -89,7 +89,10 @@ vec3 line(sampler2D source, sampler2D smoothSource, const int mode, vec2 directi
     vec3 foreground = vec3(0.0);
     float coverage = 0.0;
 #endif
-    for (int k = 1; k <= taps; ++k) {
+    // MAX_TAPS is a compile-time constant so that the compiler can unroll the loop.
+    for (int k = 1; k <= MAX_TAPS; ++k) {
+        if (k > taps)
+            break;
         const float distance = float(k) * step;
         const vec2 coords = vUv + direction * distance;
         vec4 tap;

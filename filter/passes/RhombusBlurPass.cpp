@@ -69,24 +69,26 @@ RhombusBlurPass::RhombusBlurPass()
     for (const bool first : {true, false})
         for (const bool near : {false, true})
             for (const bool tiles : {false, true})
-                program(first, near, tiles, modes[first ? 0 : 2], modes[first ? 1 : 3]);
+                program(first, near, tiles, modes[first ? 0 : 2], modes[first ? 1 : 3], kDefaultTaps);
 }
 
-const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, LineMode line1, LineMode line2)
+const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, LineMode line1, LineMode line2,
+                                            int taps)
 {
     const int key = (first ? 1 : 0) | (near ? 2 : 0) | (tiles ? 4 : 0) | static_cast<int>(line1) << 3 |
-                    static_cast<int>(line2) << 5;
+                    static_cast<int>(line2) << 5 | taps << 7;
     gl::Program& slot = programs_[key];
     if (slot.id() == 0) {
         std::vector<std::string> defines{fmt::format("LINE1_MODE {}", static_cast<int>(line1)),
-                                         fmt::format("LINE2_MODE {}", static_cast<int>(line2))};
+                                         fmt::format("LINE2_MODE {}", static_cast<int>(line2)),
+                                         fmt::format("MAX_TAPS {}", taps)};
         if (first)
             defines.emplace_back("FIRST_PASS 1");
         if (near)
             defines.emplace_back("NEAR_FIELD 1");
-        const std::string name = fmt::format("rhombus_blur{}{}{} {}{}", first ? " first" : " second",
+        const std::string name = fmt::format("rhombus_blur{}{}{} {}{} x{}", first ? " first" : " second",
                                              near ? " near" : "", tiles ? " tiles" : "", static_cast<int>(line1),
-                                             static_cast<int>(line2));
+                                             static_cast<int>(line2), taps);
         slot = gl::Program(tiles ? "tiles.vert" : "fullscreen.vert", "rhombus_blur.frag", name, defines);
     }
     return slot;
@@ -126,7 +128,6 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
         halfPixelAcross(line1, width, height, &u.across[0]);
     if (mode2 == LineMode::Pair)
         halfPixelAcross(line2, width, height, &u.across[2]);
-    u.maxTaps = taps;
     u.nearTileSize = tileSize;
     u.bleedingBias = HexBlurPass::kBleedingBias;
     u.bleedingMult = HexBlurPass::kBleedingMult;
@@ -143,7 +144,7 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
     bindTexture(4, second.id(), linear_.id());
     if (io.nearDiameter)
         bindTexture(2, io.nearDiameter->id(), nearest_.id());
-    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2).use();
+    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, taps).use();
     if (tiles)
         tiles->draw();
     else

@@ -17,6 +17,9 @@ public:
     /// Taps per line at most. Lines take one tap per pixel of their length up to `taps`;
     /// longer ones space `taps` taps out evenly.
     static constexpr int kMaxTaps = 64;
+    /// The tap count whose programs are compiled up front (the balanced preset's); others
+    /// compile on first use.
+    static constexpr int kDefaultTaps = 8;
     /// The paper's bleeding rule fades in over this much CoC around its threshold (pixels), so
     /// that it does not switch on depth noise. In pixels, not the paper's unit (a fraction of
     /// the image height): a frame one pixel high would otherwise switch within 0.01 px.
@@ -53,7 +56,7 @@ private:
         float directions[4];
         float across[4];
         float baseSteps[2]; ///< std140: the ints follow the vec2 directly
-        int maxTaps;
+        int unusedMaxTaps;
         int nearTileSize;
         float bleedingBias;
         float bleedingMult;
@@ -64,7 +67,7 @@ private:
     enum class LineMode { Point = 0, Smooth = 1, Pair = 2 };
     static std::array<LineMode, 4> lineModes(const Directions& directions);
     /// The program of one variant, compiled on first use: pass, near field, tiles, line modes.
-    const gl::Program& program(bool first, bool near, bool tiles, LineMode line1, LineMode line2);
+    const gl::Program& program(bool first, bool near, bool tiles, LineMode line1, LineMode line2, int taps);
     std::map<int, gl::Program> programs_;
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
