@@ -85,7 +85,14 @@ std::string summarise(std::size_t in, std::size_t out, const std::map<std::strin
 {
     const double n = static_cast<double>(std::max<std::size_t>(timed, 1));
     std::string passes;
-    for (const char* name : {"coc", "horizontal", "diagonal-a", "diagonal-b", "composite", "view"})
+    // Passes in the order they run; any other pass after them.
+    const std::vector<std::string> order{"coc",        "horizontal", "diagonal-a", "diagonal-b", "rhombi-1",
+                                         "rhombi-2",   "near-field", "composite",  "view"};
+    auto names = order;
+    for (const auto& [name, ms] : passMs)
+        if (std::find(order.begin(), order.end(), name) == order.end())
+            names.push_back(name);
+    for (const auto& name : names)
         if (const auto found = passMs.find(name); found != passMs.end())
             passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", name, found->second / n);
     return fmt::format("defocus: {} frames in, {} frames out, {:.1f} ms/frame (GPU per pass: {}; upload {:.1f}, "
