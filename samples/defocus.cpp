@@ -29,6 +29,7 @@
 #include "samples/Progress.hpp"
 #include "sinks/FrameSink.hpp"
 #include "sources/FrameSource.hpp"
+#include "sources/SyntheticSource.hpp"
 
 namespace {
 
@@ -65,6 +66,8 @@ struct Options {
     std::string timings;
     bool explain = false;
     bool info = false;
+    bool demo = false; ///< a synthetic clip instead of INPUT
+    std::string demoScene = "spheres";
     bool quiet = false;
     bool verbose = false;
 };
@@ -173,12 +176,34 @@ Frame halfFrame(const Frame& frame)
     return half;
 }
 
+/// --demo: a synthetic scene's shot (docs/synthetic.md) through the command line's lens; with
+/// 'auto' focus, the focus follows the scene's focus pull.
+std::unique_ptr<SyntheticSource> openDemo(const Options& options)
+{
+    SyntheticSettings settings;
+    settings.frames = options.frames.value_or(60);
+    settings.lens = options.lens;
+    settings.focusPull = options.focus == "auto";
+    return std::make_unique<SyntheticSource>(syntheticScene(options.demoScene), settings);
+}
+
 int run(const Options& options)
 {
-    SourceOptions sourceOptions{options.input, std::nullopt, options.depthScale};
-    if (!options.depth.empty())
-        sourceOptions.depth = options.depth;
-    auto source = openSource(sourceOptions);
+    // --demo renders its frames with GL, so its context comes first (the filter shares it).
+    std::optional<gl::EglContext> demoContext;
+    std::unique_ptr<FrameSource> source;
+    SyntheticSource* demo = nullptr;
+    if (options.demo) {
+        demoContext.emplace(gl::EglContext::create());
+        auto synthetic = openDemo(options);
+        demo = synthetic.get();
+        source = std::move(synthetic);
+    } else {
+        SourceOptions sourceOptions{options.input, std::nullopt, options.depthScale};
+        if (!options.depth.empty())
+            sourceOptions.depth = options.depth;
+        source = openSource(sourceOptions);
+    }
 
     View view = View::Composite;
     parseView(options.view, view); // validated by CLI11's check
@@ -187,7 +212,7 @@ int run(const Options& options)
                             false};
     auto sink = openSink(sinkOptions);
 
-    auto context = gl::EglContext::create();
+    auto context = demoContext ? std::move(*demoContext) : gl::EglContext::create();
     Pipeline pipeline;
     if (!options.quiet)
         spdlog::info("{} -> {} on {}", source->describe(), options.output, context.info().glRenderer);
@@ -216,7 +241,9 @@ int run(const Options& options)
             if (!frame)
                 break;
             ++framesIn;
-            if (framesIn == 1 && options.focus == "auto") {
+            if (demo && options.focus == "auto") {
+                lens.focusM = demo->lensAt(frame->index).focusM; // the scene's focus pull
+            } else if (framesIn == 1 && options.focus == "auto") {
                 lens.focusM = centreDepth(frame->depth, 0.1, 2.0f);
                 if (!options.quiet)
                     spdlog::info("focus: auto -> {:.2f} m (median depth of the centre of {})", lens.focusM, frame->name);
@@ -357,6 +384,12 @@ int main(int argc, char** argv)
                  "Spread blurred foreground over what is behind it [default: from --quality]");
     app.add_flag("--always-on", alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
     app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
+    app.add_flag("--demo", o.demo,
+                 "No INPUT: render a synthetic clip (60 frames, a focus pull; --frames sets its length) and blur "
+                 "it; the lens options drive its camera too");
+    app.add_option("--demo-scene", o.demoScene, "Scene for --demo: spheres or edges")
+        ->check(CLI::IsMember(syntheticSceneNames()))
+        ->capture_default_str();
     app.add_flag("-q,--quiet", o.quiet, "Only the summary line and errors");
     app.add_flag("-v,--verbose", o.verbose, "Debug logging");
 
@@ -371,7 +404,11 @@ int main(int argc, char** argv)
     try {
         if (o.info)
             return printInfo();
-        if (o.input.empty() || o.output.empty()) {
+        if (o.demo && !o.input.empty()) {
+            spdlog::error("--demo renders its own input; drop INPUT '{}'", o.input);
+            return kUsage;
+        }
+        if ((o.input.empty() && !o.demo) || o.output.empty()) {
             spdlog::error("INPUT and -o OUTPUT are required (see --help)");
             return kUsage;
         }
