@@ -37,6 +37,7 @@
 #include "filter/methods/Presets.hpp"
 #include "sources/ImageIO.hpp"
 #include "samples/BenchMachine.hpp"
+#include "sources/SyntheticScene.hpp"
 
 namespace {
 
@@ -56,7 +57,11 @@ struct Options {
     bool noReference = false;
     bool noTimers = false;
     std::string replot; ///< accuracy.json of an earlier run: draw its Pareto plot only
+    std::string scene = "blender"; ///< or "synthetic[:NAME]": input and truth rendered (docs/synthetic.md)
 };
+
+/// The scene and truth measured against, for the plot's title (set by --scene).
+std::string gTruthTitle = "Blender spheres 640x480 vs Cycles thin-lens truth";
 
 /// Figures quoted from ../shared/data/README.md and issue 4 for comparison: not measured here.
 struct Quoted {
@@ -272,9 +277,7 @@ cv::Mat paretoPlot(const std::vector<Row>& rows, double unblurredDb)
                 ink, 1, cv::LINE_AA);
     cv::putText(plot, "dB", {15, area.y + 10}, font, 0.5, ink, 1, cv::LINE_AA);
     cv::putText(plot,
-                fmt::format("Blender spheres 640x480 vs Cycles thin-lens truth: linear PSNR (clipped to [0,1]); "
-                            "unblurred {:.1f} dB",
-                            unblurredDb),
+                fmt::format("{}: linear PSNR (clipped to [0,1]); unblurred {:.1f} dB", gTruthTitle, unblurredDb),
                 {left, 30}, font, 0.55, ink, 1, cv::LINE_AA);
 
     // Targets of issue 4 and the quoted Blender point.
@@ -540,19 +543,43 @@ int run(const Options& options, const std::string& commandLine)
 {
     if (!options.replot.empty())
         return replot(options);
-    const fs::path dir = options.data;
-    std::error_code ec;
-    if (!fs::is_directory(dir, ec))
-        throw std::runtime_error(fmt::format(
-            "data folder '{}' not found (looked from '{}'); run from the repository root or pass --data DIR",
-            dir.string(), fs::current_path(ec).string()));
-    const cv::Mat color = readColor(dir / "color_linear.exr");
-    const cv::Mat depth = readDepth(dir / "depth.exr", 1000.0);
-    const cv::Mat truth = readColor(dir / "truth_f1.4_focus5_linear.exr");
-    if (truth.size() != color.size())
-        throw std::runtime_error("the truth and the input differ in size");
-    const Frame frame{color, depth, 0.0, 0, "blender_spheres"};
     const LensSettings lens = blenderLens();
+    cv::Mat color, depth, truth;
+    std::string sceneLabel = options.data;
+    // --scene synthetic[:NAME]: input and truth rendered here with the Blender scene's lens and
+    // aperture (6 blades, a corner up), the truth from 256 lens positions; GL is needed first.
+    std::optional<gl::EglContext> early;
+    if (options.scene != "blender") {
+        early.emplace(gl::EglContext::create());
+        const std::string name = options.scene.size() > 10 ? options.scene.substr(10) : "spheres";
+        SyntheticSettings settings;
+        settings.frames = 1;
+        settings.lens = blenderLens(); // the truth's aperture has a corner up, as Cycles' does
+        settings.focusPull = false;
+        SyntheticScene scene(syntheticScene(name), settings);
+        const SyntheticImages images = scene.render(0);
+        color = images.frame.color;
+        depth = images.frame.depth;
+        truth = images.reference;
+        sceneLabel = "synthetic:" + name;
+        gTruthTitle = fmt::format("synthetic {} 640x480 vs {}-sample accumulated thin-lens truth", name,
+                                  settings.aperture.samples);
+        fmt::print(stderr, "defocus-bench-accuracy: {} rendered, truth {} renders in {:.0f} ms\n", sceneLabel,
+                   settings.aperture.samples, images.referenceMs);
+    } else {
+        const fs::path dir = options.data;
+        std::error_code ec;
+        if (!fs::is_directory(dir, ec))
+            throw std::runtime_error(fmt::format(
+                "data folder '{}' not found (looked from '{}'); run from the repository root or pass --data DIR",
+                dir.string(), fs::current_path(ec).string()));
+        color = readColor(dir / "color_linear.exr");
+        depth = readDepth(dir / "depth.exr", 1000.0);
+        truth = readColor(dir / "truth_f1.4_focus5_linear.exr");
+        if (truth.size() != color.size())
+            throw std::runtime_error("the truth and the input differ in size");
+    }
+    const Frame frame{color, depth, 0.0, 0, sceneLabel};
 
     // Regions from the thin-lens CoC of the filled depth, as the filter sees it.
     const cv::Mat coc = cocMap(prepareDepth(depth, color.size(), static_cast<float>(lens.focusM)).metres,
@@ -560,7 +587,7 @@ int run(const Options& options, const std::string& commandLine)
     const cv::Mat regions = regionMap(coc);
     const ErrorReport unblurred = measureError(color, truth, regions);
 
-    auto context = gl::EglContext::create();
+    auto context = early ? std::move(*early) : gl::EglContext::create();
     const gl::ContextInfo& info = context.info();
     const std::string cpu = cpuModel();
     const unsigned cores = std::thread::hardware_concurrency();
@@ -568,7 +595,7 @@ int run(const Options& options, const std::string& commandLine)
     fmt::print("defocus-bench-accuracy, {}\n", utcNow());
     fmt::print("GL renderer: {}; GL {}; EGL platform: {}\nCPU: {}, {} cores; load average {:.2f} before the runs\n",
                info.glRenderer, info.glVersion, info.platform, cpu, cores, loadBefore);
-    fmt::print("scene: {} {}x{}; lens 85 mm f/1.4 focused at 5 m, 36 mm sensor, max-coc 64 px\n", dir.string(),
+    fmt::print("scene: {} {}x{}; lens 85 mm f/1.4 focused at 5 m, 36 mm sensor, max-coc 64 px\n", sceneLabel,
                color.cols, color.rows);
     fmt::print("error: against the Cycles thin-lens truth; PSNR of linear values clipped to [0,1] (and after sRGB "
                "encoding), SSIM on luma; regions in-focus {:.1f}%, out-of-focus {:.1f}%, depth-edge {:.1f}% "
@@ -669,7 +696,7 @@ int run(const Options& options, const std::string& commandLine)
                        {"glVersion", info.glVersion},
                        {"eglPlatform", info.platform},
                        {"timerQueries", info.timerQueries && !options.noTimers}};
-    json["scene"] = {{"data", dir.string()},
+    json["scene"] = {{"data", sceneLabel},
                      {"width", color.cols},
                      {"height", color.rows},
                      {"lens", {{"focalLengthMm", lens.focalLengthMm},
@@ -713,7 +740,8 @@ int run(const Options& options, const std::string& commandLine)
         throw std::runtime_error("cannot write pareto.png");
 
     // Contact sheet: input, truth, the references, the presets' rows, the older methods.
-    std::vector<std::pair<std::string, const cv::Mat*>> images{{"input", &color}, {"truth (Cycles)", &truth}};
+    const std::string truthLabel = options.scene == "blender" ? "truth (Cycles)" : "truth (accumulated)";
+    std::vector<std::pair<std::string, const cv::Mat*>> images{{"input", &color}, {truthLabel, &truth}};
     const auto add = [&](const std::string& label, const std::string& method, const MethodSettings* settings) {
         for (const Row& row : rows)
             if (row.info->name == method &&
@@ -768,6 +796,14 @@ int main(int argc, char** argv)
     app.add_flag("--no-reference", options.noReference, "skip the CPU references (seconds each)");
     app.add_flag("--no-timers", options.noTimers, "no GL timer queries");
     app.add_option("--replot", options.replot, "only redraw --out/pareto.png from an earlier run's accuracy.json");
+    std::vector<std::string> scenes{"blender", "synthetic"};
+    for (const std::string& name : syntheticSceneNames())
+        scenes.push_back("synthetic:" + name);
+    app.add_option("--scene", options.scene,
+                   "blender (--data, the Cycles truth) or synthetic[:NAME] (spheres or edges, rendered with a "
+                   "256-sample thin-lens truth; docs/synthetic.md)")
+        ->check(CLI::IsMember(scenes))
+        ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
     std::stringstream list(methods);
