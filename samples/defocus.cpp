@@ -350,8 +350,9 @@ int main(int argc, char** argv)
     app.add_option("--far", o.lens.farLimitM, "focal-range model: metres where far blur reaches --max-coc")
         ->capture_default_str();
     app.add_option("--quality", o.qualityPreset,
-                   "Preset from the accuracy benchmark (docs/accuracy.md): fast (12 taps at half size), balanced "
-                   "(16 taps), high (48 taps); --samples and --precision override it")
+                   "Preset from the accuracy benchmark (docs/accuracy.md): fast (rhombi with near field, 6 taps, at "
+                   "half size), balanced (6 taps), high (12 taps); --samples, --precision, --hexagon and "
+                   "--near-field override it")
         ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
     app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");

@@ -29,6 +29,7 @@
 #include "filter/Settings.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "sources/FrameSource.hpp"
+#include "filter/methods/Presets.hpp"
 #include "samples/BenchMachine.hpp"
 #include "samples/BenchTiming.hpp"
 
@@ -48,8 +49,11 @@ struct Options {
     std::vector<std::string> sizes = {"640x480", "1920x1080"};
     int runs = 15;
     int warmup = 3;
-    int samples = QualitySettings{}.samples;
-    std::string precision = "16f";
+    std::string preset = "balanced";  ///< full-resolution presets only: the pipeline runs alone
+    std::optional<int> samples;        ///< overrides the preset's
+    std::optional<std::string> precision;
+    std::optional<std::string> kernel; ///< "rhombi" or "mcintosh"
+    std::optional<bool> nearField;
     double focusM = 1.0;
     double fNumber = 2.0;
     double focalLengthMm = 50.0;
@@ -372,10 +376,17 @@ int run(const Options& options, const std::string& commandLine)
     for (const std::string& text : options.sizes)
         sizes.push_back(parseSize(text));
 
-    QualitySettings quality;
-    quality.samples = options.samples;
-    quality.targetFormat = options.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
+    QualitySettings quality = presetSettings(options.preset);
+    if (options.samples)
+        quality.samples = *options.samples;
+    if (options.precision)
+        quality.targetFormat = *options.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
+    if (options.kernel)
+        parseKernel(*options.kernel, quality.kernel);
+    if (options.nearField)
+        quality.nearField = *options.nearField;
     quality.adaptive = !options.noAdaptive;
+    const std::string precision = quality.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
     LensSettings baseLens;
     baseLens.model = CocModel::ThinLens;
     baseLens.focusM = options.focusM;
@@ -407,8 +418,10 @@ int run(const Options& options, const std::string& commandLine)
     fmt::print("GL renderer: {}; GL {}; EGL platform: {}\nCPU: {}, {} cores; load average {:.2f} before the runs "
                "(figures are only comparable on an otherwise idle machine)\n",
                info.glRenderer, info.glVersion, info.platform, cpu, cores, loadBefore);
-    fmt::print("clip: {} ({} frames, cycled); {} samples, {}, {}; {} runs after {} warm-up frames per scene\n",
-               options.data, clip.size(), quality.samples, options.precision == "32f" ? "RGBA32F" : "RGBA16F",
+    fmt::print("clip: {} ({} frames, cycled); --quality {}: {} {} taps{}, {}, {}; {} runs after {} warm-up frames "
+               "per scene\n",
+               options.data, clip.size(), options.preset, kernelName(quality.kernel), quality.samples,
+               quality.nearField ? " + near field" : "", precision == "32f" ? "RGBA32F" : "RGBA16F",
                quality.adaptive ? "adaptive (in-focus frames and tiles skipped)" : "every pass on every pixel",
                options.runs, options.warmup);
     fmt::print("lens: thin lens {} mm f/{} focused at {} m, 36 mm sensor, max-coc {} px per 640 px of width\n",
@@ -478,8 +491,11 @@ int run(const Options& options, const std::string& commandLine)
              {{"data", options.data},
               {"runs", options.runs},
               {"warmup", options.warmup},
+              {"preset", options.preset},
+              {"kernel", kernelName(quality.kernel)},
+              {"nearField", quality.nearField},
               {"samples", quality.samples},
-              {"precision", options.precision},
+              {"precision", precision},
               {"adaptive", quality.adaptive},
               {"focusM", options.focusM},
               {"fNumber", options.fNumber},
@@ -557,10 +573,16 @@ int main(int argc, char** argv)
     app.add_option("--warmup", o.warmup, "Unmeasured frames first, per size and scene")
         ->check(CLI::Range(0, 1000))
         ->capture_default_str();
-    app.add_option("--samples", o.samples, "Taps per directional blur pass, 2..64")->capture_default_str();
-    app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f")
-        ->check(CLI::IsMember({"16f", "32f"}))
+    app.add_option("--quality", o.preset, "Preset (docs/accuracy.md): balanced or high (fast runs at half size, "
+                                          "which the pipeline alone does not)")
+        ->check(CLI::IsMember({"balanced", "high"}))
         ->capture_default_str();
+    app.add_option("--samples", o.samples, "Taps per directional blur, 2..64 [default: from --quality]");
+    app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
+        ->check(CLI::IsMember({"16f", "32f"}));
+    app.add_option("--hexagon", o.kernel, "rhombi or mcintosh [default: from --quality]")
+        ->check(CLI::IsMember({"rhombi", "mcintosh"}));
+    app.add_option("--near-field", o.nearField, "true or false [default: from --quality]");
     app.add_option("--focus", o.focusM, "Distance in focus, metres")->capture_default_str();
     app.add_option("--f-number", o.fNumber, "Aperture as an f-number")->capture_default_str();
     app.add_option("--focal-length", o.focalLengthMm, "Focal length, millimetres")->capture_default_str();

@@ -57,6 +57,7 @@ struct Options {
     bool noReference = false;
     bool noTimers = false;
     std::string replot; ///< accuracy.json of an earlier run: draw its Pareto plot only
+    double bladeRotationDeg = 0.0; ///< the GPU methods' hexagon; 0 = a corner on top, as the truth
     std::string scene = "blender"; ///< or "synthetic[:NAME]": input and truth rendered (docs/synthetic.md)
 };
 
@@ -543,7 +544,8 @@ int run(const Options& options, const std::string& commandLine)
 {
     if (!options.replot.empty())
         return replot(options);
-    const LensSettings lens = blenderLens();
+    LensSettings lens = blenderLens();
+    lens.bladeRotationDeg = options.bladeRotationDeg;
     cv::Mat color, depth, truth;
     std::string sceneLabel = options.data;
     // --scene synthetic[:NAME]: input and truth rendered here with the Blender scene's lens and
@@ -794,6 +796,10 @@ int main(int argc, char** argv)
     app.add_option("--methods", methods, "comma-separated subset of: mcintosh,mcintosh-near,rhombi,rhombi-near,riguer,"
                                          "lazy8,gaussian5x5,reference,reference-pointy (default: all)");
     app.add_flag("--no-reference", options.noReference, "skip the CPU references (seconds each)");
+    app.add_option("--blade-rotation", options.bladeRotationDeg,
+                   "hexagon of the GPU methods, degrees (0 = a corner on top, as the truths; 30 = flat top)")
+        ->check(CLI::Range(-180.0, 180.0))
+        ->capture_default_str();
     app.add_flag("--no-timers", options.noTimers, "no GL timer queries");
     app.add_option("--replot", options.replot, "only redraw --out/pareto.png from an earlier run's accuracy.json");
     std::vector<std::string> scenes{"blender", "synthetic"};

@@ -24,6 +24,7 @@
 #include "filter/Pipeline.hpp"
 #include "filter/Settings.hpp"
 #include "filter/gl/EglContext.hpp"
+#include "filter/methods/Presets.hpp"
 #include "samples/LiveLoop.hpp"
 #include "sinks/DisplaySink.hpp"
 #include "sources/FrameSource.hpp"
@@ -54,7 +55,8 @@ struct Options {
     std::string model = "thin-lens";
     std::optional<double> nearM;
     std::optional<double> farM;
-    QualitySettings quality;
+    /// The balanced preset (full resolution, which a live loop needs).
+    QualitySettings quality = presetSettings(kDefaultPreset);
     std::string view = "composite";
     AutofocusSettings autofocus;
     std::optional<std::size_t> frames;

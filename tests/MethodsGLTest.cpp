@@ -209,7 +209,10 @@ TEST_F(Methods, ReferenceBeatsEveryGpuMethodOnTheBlenderScene)
     // The reference runs at full size: it took 4-17 s for 640x480 on the 2-core development
     // machine (depending on other load), inside the 30 s this test allows it.
     const auto start = std::chrono::steady_clock::now();
-    const MethodResult reference = createMethod("reference")->run(frame, lens, {});
+    // The reference with the truth's orientation (a corner on top, like the GPU methods by
+    // default): the flat-topped one measured 34.57 dB, which the rhombi with their near field
+    // come within 0.2 dB of.
+    const MethodResult reference = createMethod("reference-pointy")->run(frame, lens, {});
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const double referenceDb = psnrLinear(reference.linear, truth);
     std::printf("[ FIGURE   ] reference: %.2f dB in %.1f s\n", referenceDb, seconds);
@@ -219,9 +222,9 @@ TEST_F(Methods, ReferenceBeatsEveryGpuMethodOnTheBlenderScene)
         std::printf("[ FIGURE   ] %s: %.2f dB\n", describe(*info, settings).c_str(), db);
         EXPECT_GT(referenceDb, db) << describe(*info, settings);
     }
-    // Its figure when this test was written: 34.57 dB (Blender's Defocus node: 32.9 dB). A
+    // Its figure when this test was written: 35.55 dB (Blender's Defocus node: 32.9 dB). A
     // margin of 1 dB for other drivers' rounding; the data is fixed.
-    EXPECT_GT(referenceDb, 33.5);
+    EXPECT_GT(referenceDb, 34.5);
 }
 
 TEST(Presets, AreKnownSettings)

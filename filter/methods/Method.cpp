@@ -38,13 +38,13 @@ const std::vector<MethodInfo>& methodRegistry()
 {
     static const std::vector<MethodInfo> registry{
         {"mcintosh", "McIntosh et al. 2012 hexagonal chain (blurs along three edges, min)", true,
-         {4, 8, 12, 16, 24, 32, 48, 64}, limits::kSamples[0], limits::kSamples[1]},
-        {"mcintosh-near", "the same with a blurred foreground layer over it", true, {8, 16, 32, 48},
+         {4, 8, 12, 16, 24, 32, 48}, limits::kSamples[0], limits::kSamples[1]},
+        {"mcintosh-near", "the same with a blurred foreground layer over it", true, {16, 48}, limits::kSamples[0],
+         limits::kSamples[1]},
+        {"rhombi", "three one-sided rhombi summed: flat hexagon, paper's bleeding rule", true, {4, 6, 8, 12},
          limits::kSamples[0], limits::kSamples[1]},
-        {"rhombi", "three one-sided rhombi summed: flat hexagon, paper's bleeding rule", true, {4, 6, 8, 12, 16, 24},
+        {"rhombi-near", "the same, foreground counted by its own CoC (scatter as gather)", true, {4, 6, 8, 12, 16},
          limits::kSamples[0], limits::kSamples[1]},
-        {"rhombi-near", "the same, foreground counted by its own CoC (scatter as gather)", true,
-         {4, 6, 8, 12, 16, 24, 32}, limits::kSamples[0], limits::kSamples[1]},
         {"riguer", "Riguer et al. 2004 12-tap Poisson disc with their bleeding rule", true, {12}, 12, 12},
         {"lazy8", "8-point lazy gather with a blurriness-difference threshold", true, {8}, 8, 8},
         {"gaussian5x5", "5x5 Gaussian spread by |CoC| (distance from the plane in focus)", true, {25}, 25, 25},
