@@ -15,9 +15,9 @@ float SceneAnalysis::maxAbsCoc() const
     return std::max(std::abs(minCoc), std::abs(maxCoc));
 }
 
-bool SceneAnalysis::tileNeedsBlur(int x, int y) const
+bool SceneAnalysis::tileNeedsBlur(int x, int y, float sharpBelowPx) const
 {
-    return std::max(std::abs(tileMinCoc.at<float>(y, x)), std::abs(tileMaxCoc.at<float>(y, x))) >= 0.5f;
+    return std::max(std::abs(tileMinCoc.at<float>(y, x)), std::abs(tileMaxCoc.at<float>(y, x))) >= sharpBelowPx;
 }
 
 SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k,
@@ -97,13 +97,16 @@ FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel 
         return plan;
     plan.nearField = nearField && analysis.foreground;
     plan.kernel = kernel;
+    // The blur passes leave a pixel alone below this |CoC|: McIntosh's at 0.5 px, the rhombi's at
+    // 1 px (a line shorter than half a pixel is the centre alone), so their tiles skip more.
+    const float sharpBelow = kernel == HexagonKernel::RhombiSum ? 1.0f : 0.5f;
     for (int y = 0; y < analysis.tiles.height; ++y)
         for (int x = 0; x < analysis.tiles.width; ++x) {
-            const bool near = plan.nearField && analysis.tileNearDiameter.at<float>(y, x) >= 0.5f;
+            const bool near = plan.nearField && analysis.tileNearDiameter.at<float>(y, x) >= sharpBelow;
             if (near)
                 plan.nearTiles.emplace_back(x, y);
             // The rhombus blur handles the foreground itself: tiles it reaches are blurred too.
-            const bool blur = analysis.tileNeedsBlur(x, y) || (near && kernel == HexagonKernel::RhombiSum);
+            const bool blur = analysis.tileNeedsBlur(x, y, sharpBelow) || (near && kernel == HexagonKernel::RhombiSum);
             (blur ? plan.blurTiles : plan.copyTiles).emplace_back(x, y);
         }
     return plan;

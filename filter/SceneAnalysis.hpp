@@ -32,8 +32,8 @@ struct SceneAnalysis {
 
     /// Largest |CoC| of the frame.
     float maxAbsCoc() const;
-    /// |CoC| of the tile at (x, y) reaches half a pixel somewhere.
-    bool tileNeedsBlur(int x, int y) const;
+    /// |CoC| of the tile at (x, y) reaches `sharpBelowPx` somewhere (the blur's in-focus limit).
+    bool tileNeedsBlur(int x, int y, float sharpBelowPx = 0.5f) const;
 };
 
 /// Analyses a frame from its filled depth (CV_32FC1 metres) and colour (8-bit: highlights are
