@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "filter/Pipeline.hpp"
+#include "filter/methods/Presets.hpp"
 #include "sources/ImageIO.hpp"
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"
@@ -32,7 +33,7 @@ LensSettings blenderLens()
     return lens;
 }
 
-TEST_F(Accuracy, BlenderSpheresBeatsTheUnblurredInputByFar)
+TEST_F(Accuracy, BalancedPresetIsCloserToTheLensThanBlendersDefocusNode)
 {
     const auto dir = test::dataDir() / "blender_spheres";
     const cv::Mat color = readColor(dir / "color_linear.exr");
@@ -46,15 +47,33 @@ TEST_F(Accuracy, BlenderSpheresBeatsTheUnblurredInputByFar)
     EXPECT_NEAR(unblurred, 16.5, 0.1);
 
     Pipeline pipeline;
-    const cv::Mat out = pipeline.run({color, depth, 0.0, 0, "blender"}, blenderLens(), {}, View::Composite,
-                                     Encoding::Linear32F);
+    const cv::Mat out = pipeline.run({color, depth, 0.0, 0, "blender"}, blenderLens(), presetSettings("balanced"),
+                                     View::Composite, Encoding::Linear32F);
     EXPECT_TRUE(test::allFinite(out));
     const double psnr = psnrClipped(out, truth);
-    std::printf("[ FIGURE   ] Blender spheres, McIntosh 16 taps, RGBA16F: %.2f dB (unblurred %.2f dB)\n", psnr,
-                unblurred);
-    // "Far above" the input: the plain McIntosh chain measured about 30 dB on this scene; 8 dB
-    // over the input leaves room for sampling differences between drivers.
-    EXPECT_GT(psnr, unblurred + 8.0);
+
+    // McIntosh et al.'s chain as published: 16 taps, flat top (its first pass horizontal).
+    QualitySettings published;
+    published.kernel = HexagonKernel::McIntoshMin;
+    published.samples = 16;
+    LensSettings flatTop = blenderLens();
+    flatTop.bladeRotationDeg = 30.0;
+    const double mcintosh =
+        psnrClipped(pipeline.run({color, depth, 0.0, 0, "blender"}, flatTop, published, View::Composite,
+                                 Encoding::Linear32F),
+                    truth);
+    std::printf("[ FIGURE   ] Blender spheres: balanced preset %.2f dB, McIntosh 16 taps as published %.2f dB "
+                "(unblurred %.2f dB)\n",
+                psnr, mcintosh, unblurred);
+    // The claim of docs/accuracy.md: the default preset is closer to the path-traced lens than
+    // Blender's compositor Defocus node at its best (32.9 dB, quoted by the scene's README).
+    // Measured 33.91 dB on llvmpipe; other drivers' rounding moves such figures by a few
+    // hundredths of a dB.
+    EXPECT_GT(psnr, 32.9);
+    // And the published chain stays where it was measured (30.27 dB), 3.6 dB under it: 2 dB of
+    // margin between the two, so a regression of either kernel shows.
+    EXPECT_GT(mcintosh, unblurred + 8.0);
+    EXPECT_GT(psnr, mcintosh + 2.0);
 }
 
 } // namespace
