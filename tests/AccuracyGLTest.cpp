@@ -22,17 +22,6 @@ double psnrClipped(const cv::Mat& a, const cv::Mat& b)
     return cv::PSNR(ca, cb, 1.0);
 }
 
-LensSettings blenderLens()
-{
-    LensSettings lens;
-    lens.focalLengthMm = 85.0;
-    lens.fNumber = 1.4;
-    lens.focusM = 5.0;
-    lens.sensorWidthMm = 36.0;
-    lens.maxCocPx = 64.0; // above the scene's largest CoC (46.6 px), so nothing is clamped
-    return lens;
-}
-
 TEST_F(Accuracy, BalancedPresetIsCloserToTheLensThanBlendersDefocusNode)
 {
     const auto dir = test::dataDir() / "blender_spheres";
@@ -47,7 +36,7 @@ TEST_F(Accuracy, BalancedPresetIsCloserToTheLensThanBlendersDefocusNode)
     EXPECT_NEAR(unblurred, 16.5, 0.1);
 
     Pipeline pipeline;
-    const cv::Mat out = pipeline.run({color, depth, 0.0, 0, "blender"}, blenderLens(), presetSettings("balanced"),
+    const cv::Mat out = pipeline.run({color, depth, 0.0, 0, "blender"}, test::blenderSpheresLens(), presetSettings("balanced"),
                                      View::Composite, Encoding::Linear32F);
     EXPECT_TRUE(test::allFinite(out));
     const double psnr = psnrClipped(out, truth);
@@ -56,7 +45,7 @@ TEST_F(Accuracy, BalancedPresetIsCloserToTheLensThanBlendersDefocusNode)
     QualitySettings published;
     published.kernel = HexagonKernel::McIntoshMin;
     published.samples = 16;
-    LensSettings flatTop = blenderLens();
+    LensSettings flatTop = test::blenderSpheresLens();
     flatTop.bladeRotationDeg = 30.0;
     const double mcintosh =
         psnrClipped(pipeline.run({color, depth, 0.0, 0, "blender"}, flatTop, published, View::Composite,

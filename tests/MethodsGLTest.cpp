@@ -199,12 +199,7 @@ TEST_F(Methods, ReferenceBeatsEveryGpuMethodOnTheBlenderScene)
     const cv::Mat truth = readColor(dir / "truth_f1.4_focus5_linear.exr");
     ASSERT_EQ(color.size(), cv::Size(640, 480));
     const Frame frame{color, depth, 0.0, 0, "blender"};
-    LensSettings lens;
-    lens.focalLengthMm = 85.0;
-    lens.fNumber = 1.4;
-    lens.focusM = 5.0;
-    lens.sensorWidthMm = 36.0;
-    lens.maxCocPx = 64.0;
+    const LensSettings lens = test::blenderSpheresLens();
 
     // The reference runs at full size: it took 4-17 s for 640x480 on the 2-core development
     // machine (depending on other load), inside the 30 s this test allows it.

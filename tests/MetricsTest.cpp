@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "filter/Metrics.hpp"
+#include "tests/TestSupport.hpp"
 
 namespace defocus {
 namespace {
@@ -111,11 +112,7 @@ TEST(Metrics, RegionMasksPartitionTheImage)
 
 TEST(Metrics, CocMapFollowsTheLensModel)
 {
-    LensSettings lens;
-    lens.focalLengthMm = 85.0;
-    lens.fNumber = 1.4;
-    lens.focusM = 5.0;
-    lens.maxCocPx = 64.0;
+    const LensSettings lens = test::blenderSpheresLens();
     const CocCoefficients k = cocCoefficients(lens, 640);
     cv::Mat depth(1, 3, CV_32FC1);
     depth.at<float>(0, 0) = 1.43f;

@@ -409,11 +409,7 @@ TEST_F(SyntheticSceneGL, TheCyclesTruthAgreesOnCocSizeAndOrientation)
     // at 5 m, 36 mm over 640 px) measured in the Cycles truth, and a point at 25 m rendered by
     // the synthetic reference with the same lens (640 px wide, so the CoC is the same 14.9 px;
     // 48 rows are enough).
-    LensSettings lens;
-    lens.focalLengthMm = 85.0;
-    lens.fNumber = 1.4;
-    lens.focusM = 5.0;
-    lens.sensorWidthMm = 36.0;
+    const LensSettings lens = test::blenderSpheresLens();
     const double coc = thinLensCocPixels(lens, 640, 25.0);
 
     const auto dir = test::dataDir() / "blender_spheres";
