@@ -599,10 +599,10 @@ int run(const Options& options, const std::string& commandLine)
                info.glRenderer, info.glVersion, info.platform, cpu, cores, loadBefore);
     fmt::print("scene: {} {}x{}; lens 85 mm f/1.4 focused at 5 m, 36 mm sensor, max-coc 64 px\n", sceneLabel,
                color.cols, color.rows);
-    fmt::print("error: against the Cycles thin-lens truth; PSNR of linear values clipped to [0,1] (and after sRGB "
+    fmt::print("error: {}; PSNR of linear values clipped to [0,1] (and after sRGB "
                "encoding), SSIM on luma; regions in-focus {:.1f}%, out-of-focus {:.1f}%, depth-edge {:.1f}% "
                "(filter/Metrics.hpp)\n",
-               100 * unblurred.regionShare[0], 100 * unblurred.regionShare[1], 100 * unblurred.regionShare[2]);
+               gTruthTitle, 100 * unblurred.regionShare[0], 100 * unblurred.regionShare[1], 100 * unblurred.regionShare[2]);
     fmt::print("time: median of {} runs after {} warm-up runs per setting (the CPU references: 1 run); wall = the "
                "whole frame incl. depth prep, scaling, upload and readback; GPU = GL_TIME_ELAPSED per pass{}\n",
                options.runs, options.warmup,
