@@ -6,18 +6,16 @@
 
 #include "filter/Lens.hpp"
 #include "filter/passes/HexBlurPass.hpp"
+#include "tests/TestSupport.hpp"
 
 namespace defocus {
 namespace {
 
 // The Blender scene of data/blender_spheres: 85 mm, f/1.4, focus 5 m, 36 mm over 640 px.
+/// The Blender scene's camera with max-coc at its limit, so that no figure below is clamped.
 LensSettings blenderLens()
 {
-    LensSettings lens;
-    lens.focalLengthMm = 85.0;
-    lens.fNumber = 1.4;
-    lens.focusM = 5.0;
-    lens.sensorWidthMm = 36.0;
+    LensSettings lens = test::blenderSpheresLens();
     lens.maxCocPx = 512.0;
     return lens;
 }
