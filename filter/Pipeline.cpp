@@ -37,17 +37,35 @@ double msSince(Clock::time_point start)
 struct Target {
     gl::Texture texture;
     gl::Framebuffer framebuffer;
+    /// Counts the times the texture was (re)created: a framebuffer elsewhere that holds it
+    /// (the rhombus passes' pairs) must be remade when this moves.
+    unsigned generation = 0;
 
-    /// Returns true when the texture was (re)created: framebuffers holding it need remaking.
-    bool ensure(GLenum format, cv::Size size, const char* name)
+    void ensure(GLenum format, cv::Size size, const char* name)
     {
         if (texture && texture.format() == format && texture.width() == size.width &&
             texture.height() == size.height)
-            return false;
+            return;
         framebuffer = {};
         texture = gl::Texture(format, size.width, size.height, name);
         framebuffer = gl::Framebuffer(texture, name);
-        return true;
+        ++generation;
+    }
+};
+
+/// A framebuffer with two targets' textures attached, remade whenever either texture is.
+struct TargetPair {
+    gl::Framebuffer framebuffer;
+    unsigned generations[2] = {0, 0};
+
+    const gl::Framebuffer& of(const Target& first, const Target& second, const char* name)
+    {
+        if (!framebuffer || generations[0] != first.generation || generations[1] != second.generation) {
+            framebuffer = gl::Framebuffer(first.texture, second.texture, name);
+            generations[0] = first.generation;
+            generations[1] = second.generation;
+        }
+        return framebuffer;
     }
 };
 
@@ -94,7 +112,7 @@ struct Pipeline::Impl {
     Target coc, horizontal, diagonalA, diagonalB, outSrgb, outLinear;
     // Rhombi: pass 1 writes X (horizontal) and Y (horizontalMean), pass 2 A and B (diagonalA/B).
     Target horizontalMean;
-    gl::Framebuffer firstPair, secondPair;
+    TargetPair firstPair, secondPair;
     Target nearHorizontal, nearA, nearB; ///< the foreground layer's blurs
     gl::Texture nearDiameter;            ///< per tile, R32F
 
@@ -273,11 +291,14 @@ void Pipeline::Impl::renderMcIntosh(bool useTiles)
 void Pipeline::Impl::renderRhombi(bool useTiles)
 {
     const GLenum format = coc.texture.format();
-    // Bitwise |: every target must be ensured, and any one remade means remaking its pair.
-    if (horizontal.ensure(format, size, "rhombi X") | horizontalMean.ensure(format, size, "rhombi Y") || !firstPair)
-        firstPair = gl::Framebuffer(horizontal.texture, horizontalMean.texture, "rhombi pass 1");
-    if (diagonalA.ensure(format, size, "rhombi A") | diagonalB.ensure(format, size, "rhombi B") || !secondPair)
-        secondPair = gl::Framebuffer(diagonalA.texture, diagonalB.texture, "rhombi pass 2");
+    // The McIntosh passes share horizontal and the diagonals, and may have remade them since:
+    // the pairs follow the textures' generations, not this function's own calls.
+    horizontal.ensure(format, size, "horizontal / rhombi X");
+    horizontalMean.ensure(format, size, "rhombi Y");
+    diagonalA.ensure(format, size, "diagonal A / rhombi A");
+    diagonalB.ensure(format, size, "diagonal B / rhombi B");
+    const gl::Framebuffer& first = firstPair.of(horizontal, horizontalMean, "rhombi pass 1");
+    const gl::Framebuffer& second = secondPair.of(diagonalA, diagonalB, "rhombi pass 2");
     const gl::Texture* near = nullptr;
     if (plan.nearField) {
         uploadNearDiameter();
@@ -286,16 +307,16 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
     const auto directions = RhombusBlurPass::directions(bladeRotationDeg);
     const TileList* tiles = useTiles ? &blurTiles : nullptr;
     timer.begin("rhombi-1");
-    rhombusBlurPass.run({coc.texture, nullptr, near, firstPair}, true, directions, quality.samples,
+    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, directions, quality.samples,
                         SceneAnalysis::kTileSize, tiles);
     if (useTiles)
-        copyPass.run(coc.texture, copyTiles, firstPair, true);
+        copyPass.run(coc.texture, copyTiles, first, true);
     timer.end();
     timer.begin("rhombi-2");
-    rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, secondPair}, false, directions,
+    rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, second}, false, directions,
                         quality.samples, SceneAnalysis::kTileSize, tiles);
     if (useTiles)
-        copyPass.run(horizontal.texture, copyTiles, secondPair, true);
+        copyPass.run(horizontal.texture, copyTiles, second, true);
     timer.end();
 }
 

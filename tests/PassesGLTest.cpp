@@ -234,6 +234,32 @@ TEST_F(Passes, HighlightRecoveryScalesClippedLightsThatGetBlurred)
     EXPECT_EQ(cv::norm(out(inFocus), twoLights(inFocus), cv::NORM_INF), 0.0);
 }
 
+// One pipeline that changes kernel and frame size between frames renders what a fresh one does:
+// the McIntosh passes remake targets the rhombus passes attach in pairs (a stale pair once drew
+// the rhombi into the previous size's textures and returned McIntosh's frame).
+TEST_F(Passes, SwitchingKernelsAndSizesMatchesAFreshPipeline)
+{
+    cv::Mat color(48, 64, CV_8UC3);
+    cv::randu(color, 0, 256);
+    const Frame frame{color, cv::Mat(color.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "switch"};
+    const LensSettings lens = test::lensWithFarCoc(9.0);
+    QualitySettings mcintosh, rhombi;
+    mcintosh.kernel = HexagonKernel::McIntoshMin;
+    cv::Mat small(24, 32, CV_8UC3, cv::Scalar::all(90));
+    const Frame smallFrame{small, cv::Mat(small.size(), CV_32F, cv::Scalar(2.0f)), 0.0, 0, "small"};
+
+    Pipeline switching; // its warm-up ran the rhombi at another size
+    switching.run(smallFrame, lens, rhombi, View::Composite, Encoding::Linear32F);
+    switching.run(frame, lens, mcintosh, View::Composite, Encoding::Linear32F);
+    const cv::Mat afterSwitch = switching.run(frame, lens, rhombi, View::Composite, Encoding::Linear32F);
+    Pipeline fresh;
+    const cv::Mat expected = fresh.run(frame, lens, rhombi, View::Composite, Encoding::Linear32F);
+    EXPECT_EQ(cv::norm(afterSwitch, expected, cv::NORM_INF), 0.0);
+    // And back: McIntosh after the rhombi is McIntosh.
+    const cv::Mat back = switching.run(frame, lens, mcintosh, View::Composite, Encoding::Linear32F);
+    EXPECT_EQ(cv::norm(back, fresh.run(frame, lens, mcintosh, View::Composite, Encoding::Linear32F), cv::NORM_INF), 0.0);
+}
+
 TEST_F(Passes, ConstantDepthBlursUniformly)
 {
     // A fine checkerboard blurred far wider than its period is flat grey everywhere away from
