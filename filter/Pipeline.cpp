@@ -131,6 +131,8 @@ struct Pipeline::Impl {
     SceneAnalysis analysis;
     FramePlan plan;
     bool rendered = false;
+    bool rhombiSecondPending = false; ///< rhombi: pass 2 of this frame has not written A and B
+    bool rhombiUsesTiles = false;
     bool depthPrepared = false; ///< the all-in-focus exit skips hole filling until a view needs it
     cv::Mat depthInput;
     float fallbackDepth = 1.0f;
@@ -139,7 +141,17 @@ struct Pipeline::Impl {
 
     void render();
     void renderMcIntosh(bool useTiles);
+    /// Rhombi: the CoC target's two lines (pass 1). Pass 2 waits for read(): the composite
+    /// runs fused into it, straight into the output; other views and readTarget() run it into
+    /// the A and B targets.
     void renderRhombi(bool useTiles);
+    void rhombiSecondPass(const gl::Framebuffer* fusedTarget);
+    /// Pass 2 into A and B, if this frame's are not there yet.
+    void ensureDiagonals()
+    {
+        if (rhombiSecondPending)
+            rhombiSecondPass(nullptr);
+    }
     void uploadNearDiameter();
     void prepareDepthAndPlan();
 
@@ -298,7 +310,6 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
     diagonalA.ensure(format, size, "diagonal A / rhombi A");
     diagonalB.ensure(format, size, "diagonal B / rhombi B");
     const gl::Framebuffer& first = firstPair.of(horizontal, horizontalMean, "rhombi pass 1");
-    const gl::Framebuffer& second = secondPair.of(diagonalA, diagonalB, "rhombi pass 2");
     const gl::Texture* near = nullptr;
     if (plan.nearField) {
         uploadNearDiameter();
@@ -312,12 +323,27 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
     if (useTiles)
         copyPass.run(coc.texture, copyTiles, first, true);
     timer.end();
+    rhombiSecondPending = true;
+    rhombiUsesTiles = useTiles;
+}
+
+void Pipeline::Impl::rhombiSecondPass(const gl::Framebuffer* fusedTarget)
+{
+    assert(rhombiSecondPending);
+    const gl::Texture* near = plan.nearField ? &nearDiameter : nullptr;
+    const TileList* tiles = rhombiUsesTiles ? &blurTiles : nullptr;
+    const gl::Framebuffer& target = fusedTarget ? *fusedTarget : secondPair.of(diagonalA, diagonalB, "rhombi pass 2");
+    glBindVertexArray(vao.id());
     timer.begin("rhombi-2");
-    rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, second}, false, directions,
-                        quality.samples, SceneAnalysis::kTileSize, tiles);
-    if (useTiles)
-        copyPass.run(horizontal.texture, copyTiles, second, true);
+    rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, target}, false,
+                        RhombusBlurPass::directions(bladeRotationDeg), quality.samples, SceneAnalysis::kTileSize,
+                        tiles, fusedTarget != nullptr);
+    if (rhombiUsesTiles)
+        copyPass.run(horizontal.texture, copyTiles, target, fusedTarget == nullptr);
     timer.end();
+    if (!fusedTarget) {
+        rhombiSecondPending = false; // A and B hold this frame now
+    }
 }
 
 void Pipeline::Impl::render()
@@ -351,6 +377,7 @@ void Pipeline::Impl::render()
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
     cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain));
     timer.end();
+    rhombiSecondPending = false;
     if (quality.kernel == HexagonKernel::RhombiSum)
         renderRhombi(useTiles);
     else
@@ -388,7 +415,12 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
 
     glBindVertexArray(p.vao.id());
     float low = 0.0f, high = 0.0f;
-    if (view == View::Composite) {
+    const bool fused = view == View::Composite && p.rhombiSecondPending;
+    if (fused) {
+        // Rhombi: pass 2 with the composite in it, into the output (no A and B targets); its
+        // timer scope is "rhombi-2", and no "composite" runs.
+        p.rhombiSecondPass(&out.framebuffer);
+    } else if (view == View::Composite) {
         p.timer.begin(CompositePass::kName);
         const bool near = p.plan.nearField;
         if (p.quality.kernel == HexagonKernel::RhombiSum)
@@ -397,6 +429,8 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
             p.compositePass.run(p.diagonalA.texture, p.diagonalB.texture, out.framebuffer,
                                 near ? &p.nearA.texture : nullptr, near ? &p.nearB.texture : nullptr);
     } else {
+        if (view == View::DiagonalA || view == View::DiagonalB)
+            p.ensureDiagonals();
         p.timer.begin(ViewPass::kName);
         if (view == View::Depth) {
             double lo = 0.0, hi = 0.0;
@@ -411,7 +445,8 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
             p.viewPass.run(p.target(view).texture, ViewPass::Mode::Color, 0.0f, 0.0f, out.framebuffer);
         }
     }
-    p.timer.end();
+    if (!fused)
+        p.timer.end();
 
     cv::Mat image(p.size, encoding == Encoding::Srgb8 ? CV_8UC3 : CV_32FC3);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, out.framebuffer.id());
@@ -445,6 +480,8 @@ cv::Mat Pipeline::readTarget(View view) const
 {
     if (!impl_->rendered)
         impl_->render();
+    if (view == View::DiagonalA || view == View::DiagonalB)
+        impl_->ensureDiagonals();
     const Target& target = impl_->target(view);
     cv::Mat image(impl_->size, CV_32FC4);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, target.framebuffer.id());

@@ -24,11 +24,14 @@
 // dilated on the CPU); a nearer tap that is blurrier than the centre counts where its own radius
 // reaches the centre, with the coverage a scattered segment of its length would give, and lies
 // over the centre's own blur by that coverage. FIRST_PASS and NEAR_FIELD are compile-time
-// variants: llvmpipe pays for every instruction of a branch on a uniform.
+// variants: llvmpipe pays for every instruction of a branch on a uniform. FUSED (second pass
+// only) writes the composite (A + 2B) / 3 itself, to one target: the output.
 
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outFirst;
+#ifndef FUSED
 layout(location = 1) out vec4 outSecond;
+#endif
 
 // Each line reads its texture through two units: unfiltered and bilinear.
 layout(binding = 0) uniform sampler2D uLine1;        // pass 1: rgb + signed CoC (px); pass 2: X
@@ -154,8 +157,12 @@ void main()
 #endif
     // In focus (|CoC| < 1 px) and out of any foreground's reach: the pixel stays, bit-exact.
     if (extent < 0.5) {
+#ifdef FUSED
+        outFirst = vec4(center.rgb, 1.0);
+#else
         outFirst = center;
         outSecond = centerB;
+#endif
         return;
     }
 #ifdef FIRST_PASS
@@ -165,9 +172,14 @@ void main()
         0.5 * (x + line(uLine2, uLine2Smooth, LINE2_MODE, directions.zw, baseSteps.y, across.zw, center, extent)),
         center.a);
 #else
-    outFirst = vec4(line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent),
-                    center.a);
-    outSecond = vec4(line(uLine2, uLine2Smooth, LINE2_MODE, directions.zw, baseSteps.y, across.zw, centerB, extent),
-                     center.a);
+    const vec3 a = line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent);
+    const vec3 b = line(uLine2, uLine2Smooth, LINE2_MODE, directions.zw, baseSteps.y, across.zw, centerB, extent);
+#ifdef FUSED
+    // The composite in the same pass, straight into the output (composite.frag's SUM formula).
+    outFirst = vec4(b + (a - b) * (1.0 / 3.0), 1.0);
+#else
+    outFirst = vec4(a, center.a);
+    outSecond = vec4(b, center.a);
+#endif
 #endif
 }

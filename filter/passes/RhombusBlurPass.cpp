@@ -73,10 +73,10 @@ RhombusBlurPass::RhombusBlurPass()
 }
 
 const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, LineMode line1, LineMode line2,
-                                            int taps)
+                                            int taps, bool fused)
 {
     const int key = (first ? 1 : 0) | (near ? 2 : 0) | (tiles ? 4 : 0) | static_cast<int>(line1) << 3 |
-                    static_cast<int>(line2) << 5 | taps << 7;
+                    static_cast<int>(line2) << 5 | (fused ? 1 << 7 : 0) | taps << 8;
     gl::Program& slot = programs_[key];
     if (slot.id() == 0) {
         std::vector<std::string> defines{fmt::format("LINE1_MODE {}", static_cast<int>(line1)),
@@ -86,9 +86,11 @@ const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, L
             defines.emplace_back("FIRST_PASS 1");
         if (near)
             defines.emplace_back("NEAR_FIELD 1");
-        const std::string name = fmt::format("rhombus_blur{}{}{} {}{} x{}", first ? " first" : " second",
-                                             near ? " near" : "", tiles ? " tiles" : "", static_cast<int>(line1),
-                                             static_cast<int>(line2), taps);
+        if (fused)
+            defines.emplace_back("FUSED 1");
+        const std::string name = fmt::format("rhombus_blur{}{}{}{} {}{} x{}", first ? " first" : " second",
+                                             fused ? " fused" : "", near ? " near" : "", tiles ? " tiles" : "",
+                                             static_cast<int>(line1), static_cast<int>(line2), taps);
         slot = gl::Program(tiles ? "tiles.vert" : "fullscreen.vert", "rhombus_blur.frag", name, defines);
     }
     return slot;
@@ -113,10 +115,11 @@ RhombusBlurPass::Directions RhombusBlurPass::directions(float bladeRotationDeg)
 }
 
 void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int taps, int tileSize,
-                          const TileList* tiles)
+                          const TileList* tiles, bool fused)
 {
     assert(taps >= 1 && taps <= kMaxTaps);
     assert(first || io.sourceB);
+    assert(!(first && fused));
     const int width = io.target.width(), height = io.target.height();
     const float line1 = first ? d.u1 : d.u2, line2 = first ? d.u2 : d.u3;
     Uniforms u{};
@@ -144,7 +147,7 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
     bindTexture(4, second.id(), linear_.id());
     if (io.nearDiameter)
         bindTexture(2, io.nearDiameter->id(), nearest_.id());
-    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, taps).use();
+    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, taps, fused).use();
     if (tiles)
         tiles->draw();
     else

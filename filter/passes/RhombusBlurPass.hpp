@@ -41,14 +41,15 @@ public:
         /// Per tile: the largest foreground CoC diameter that can reach it (pixels, R32F);
         /// nullptr: no near field (lines as long as the centre's own radius).
         const gl::Texture* nearDiameter;
-        const gl::Framebuffer& target; ///< two colour attachments
+        const gl::Framebuffer& target; ///< two colour attachments (one when fused)
     };
 
     RhombusBlurPass();
     /// `first`: pass 1 (lines u1 and u2 of the CoC target) or pass 2 (u2 of X, u3 of Y).
-    /// `taps`: most taps per line. With `tiles`, only those tiles are drawn.
+    /// `taps`: most taps per line. With `tiles`, only those tiles are drawn. `fused` (pass 2
+    /// only): write (A + 2B) / 3, the result, to the target's one attachment instead of A and B.
     void run(const Io& io, bool first, const Directions& directions, int taps, int tileSize,
-             const TileList* tiles = nullptr);
+             const TileList* tiles = nullptr, bool fused = false);
 
 private:
     /// Mirrors the std140 block RhombusBlurParams in rhombus_blur.frag.
@@ -67,7 +68,8 @@ private:
     enum class LineMode { Point = 0, Smooth = 1, Pair = 2 };
     static std::array<LineMode, 4> lineModes(const Directions& directions);
     /// The program of one variant, compiled on first use: pass, near field, tiles, line modes.
-    const gl::Program& program(bool first, bool near, bool tiles, LineMode line1, LineMode line2, int taps);
+    const gl::Program& program(bool first, bool near, bool tiles, LineMode line1, LineMode line2, int taps,
+                               bool fused = false);
     std::map<int, gl::Program> programs_;
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
