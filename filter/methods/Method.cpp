@@ -43,7 +43,7 @@ const std::vector<MethodInfo>& methodRegistry()
          limits::kSamples[1]},
         {"rhombi", "three one-sided rhombi summed: flat hexagon, paper's bleeding rule", true, {4, 6, 8, 12},
          limits::kSamples[0], limits::kSamples[1]},
-        {"rhombi-near", "the same, foreground counted by its own CoC (scatter as gather)", true, {4, 6, 8, 12, 16},
+        {"rhombi-near", "the same, foreground counted by its own CoC (scatter as gather)", true, {4, 5, 6, 8, 12, 16},
          limits::kSamples[0], limits::kSamples[1]},
         {"riguer", "Riguer et al. 2004 12-tap Poisson disc with their bleeding rule", true, {12}, 12, 12},
         {"lazy8", "8-point lazy gather with a blurriness-difference threshold", true, {8}, 8, 8},
