@@ -49,13 +49,15 @@ enum class TargetFormat {
 
 /// How the directional blurs make a hexagon.
 enum class HexagonKernel {
-    /// McIntosh, Riecke & DiPaola 2012 as published: blur along 0 deg, then +120 and -120 deg of
-    /// that, and the per-channel min() of the two. Three passes and a composite; the min() keeps
-    /// about 3/4 of a highlight's energy and darkens texture.
+    /// McIntosh, Riecke & DiPaola 2012: blur along an edge direction (the one nearest an axis:
+    /// 0 deg for a flat top, as published), then +120 and -120 deg of that, and the per-channel
+    /// min() of the two. Three passes and a composite; the min() keeps about 3/4 of a
+    /// highlight's energy and darkens texture.
     McIntoshMin,
     /// Three one-sided rhombi summed (shaders/rhombus_blur.frag): a flat hexagon that keeps
-    /// all of the energy, in two passes of two lines each and a composite. With nearField,
-    /// foreground spreads by its own CoC ("scatter as gather").
+    /// all of the energy, in two passes of two lines each, the composite fused into the second
+    /// when the result is read. With nearField, foreground spreads by its own CoC ("scatter as
+    /// gather").
     RhombiSum
 };
 
@@ -63,9 +65,11 @@ std::string_view kernelName(HexagonKernel kernel); ///< "mcintosh", "rhombi"
 /// Parses a name as printed by kernelName(); returns false when unknown.
 bool parseKernel(std::string_view name, HexagonKernel& kernel);
 
+/// The pipeline's defaults; the programs start from a preset instead (filter/methods/Presets.hpp:
+/// balanced = rhombi, 6 taps, near field, 32F).
 struct QualitySettings {
     /// Taps per directional blur, [2, 64]: per centred segment (McIntosh), per one-sided line
-    /// (rhombi; lines shorter than the taps are long take one tap per pixel).
+    /// (rhombi; a line shorter than this many pixels takes one tap per pixel).
     int samples = 16;
     HexagonKernel kernel = HexagonKernel::RhombiSum;
     TargetFormat targetFormat = TargetFormat::Rgba16F;
