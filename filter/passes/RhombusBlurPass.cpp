@@ -69,7 +69,9 @@ RhombusBlurPass::RhombusBlurPass()
     for (const bool first : {true, false})
         for (const bool near : {false, true})
             for (const bool tiles : {false, true})
-                program(first, near, tiles, modes[first ? 0 : 2], modes[first ? 1 : 3], kDefaultTaps);
+                for (const bool fused : {false, true})
+                    if (!(first && fused))
+                        program(first, near, tiles, modes[first ? 0 : 2], modes[first ? 1 : 3], kDefaultTaps, fused);
 }
 
 const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, LineMode line1, LineMode line2,

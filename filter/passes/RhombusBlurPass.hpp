@@ -19,7 +19,7 @@ public:
     static constexpr int kMaxTaps = 64;
     /// The tap count whose programs are compiled up front (the balanced preset's); others
     /// compile on first use.
-    static constexpr int kDefaultTaps = 8;
+    static constexpr int kDefaultTaps = 6;
     /// The paper's bleeding rule fades in over this much CoC around its threshold (pixels), so
     /// that it does not switch on depth noise. In pixels, not the paper's unit (a fraction of
     /// the image height): a frame one pixel high would otherwise switch within 0.01 px.
