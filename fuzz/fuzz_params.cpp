@@ -107,16 +107,23 @@ void checkLens(LensSettings lens, int width, float depth)
     }
 }
 
-void checkQuality(int samples, bool wide)
+void checkQuality(int samples, bool wide, double highlightGain)
 {
-    QualitySettings quality{samples, wide ? TargetFormat::Rgba32F : TargetFormat::Rgba16F};
+    QualitySettings quality;
+    quality.samples = samples;
+    quality.targetFormat = wide ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
+    quality.highlightGain = highlightGain;
     const std::vector<SettingIssue> issues = validate(quality, false);
     FUZZ_CHECK(quality.samples == samples, "validate without clamping changed samples %d", samples);
-    FUZZ_CHECK(issues.empty() == (samples >= limits::kSamples[0] && samples <= limits::kSamples[1]),
-               "samples %d: %zu issues", samples, issues.size());
+    const bool samplesOk = samples >= limits::kSamples[0] && samples <= limits::kSamples[1];
+    const bool gainOk = std::isfinite(highlightGain) && highlightGain >= limits::kHighlightGain[0] &&
+                        highlightGain <= limits::kHighlightGain[1];
+    FUZZ_CHECK(issues.size() == static_cast<std::size_t>(!samplesOk) + static_cast<std::size_t>(!gainOk),
+               "samples %d, highlight gain %g: %zu issues", samples, highlightGain, issues.size());
     checkIssues(issues);
     validate(quality, true);
-    FUZZ_CHECK(validate(quality, false).empty(), "clamping samples %d gave %d", samples, quality.samples);
+    FUZZ_CHECK(validate(quality, false).empty(), "clamping samples %d, gain %g gave %d, %g", samples, highlightGain,
+               quality.samples, quality.highlightGain);
 }
 
 } // namespace
@@ -139,7 +146,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::memcpy(&depth, &depthBits, sizeof depth);
     checkLens(lens, width, depth);
 
-    checkQuality(in.ConsumeIntegral<int>(), in.ConsumeBool());
+    const int samples = in.ConsumeIntegral<int>();
+    const bool wide = in.ConsumeBool();
+    checkQuality(samples, wide, anyDouble(in));
 
     const std::string name = in.ConsumeRemainingBytesAsString();
     View view = View::Composite;
@@ -148,6 +157,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const View v : kAllViews) {
         View back = View::Input;
         FUZZ_CHECK(parseView(viewName(v), back) && back == v, "view %d does not round-trip", static_cast<int>(v));
+    }
+    HexagonKernel kernel = HexagonKernel::RhombiSum;
+    if (parseKernel(name, kernel))
+        FUZZ_CHECK(kernelName(kernel) == name, "parseKernel('%s') gave '%s'", name.c_str(),
+                   std::string(kernelName(kernel)).c_str());
+    for (const HexagonKernel k : {HexagonKernel::McIntoshMin, HexagonKernel::RhombiSum}) {
+        HexagonKernel back = k == HexagonKernel::RhombiSum ? HexagonKernel::McIntoshMin : HexagonKernel::RhombiSum;
+        FUZZ_CHECK(parseKernel(kernelName(k), back) && back == k, "kernel %d does not round-trip", static_cast<int>(k));
     }
     return 0;
 }
