@@ -109,20 +109,6 @@ double loadAverage()
     return load;
 }
 
-/// The Blender scene's camera (../shared/data/README.md): 85 mm, f/1.4, focus 5 m, 36 mm sensor
-/// width; max-coc above the scene's largest CoC (46.6 px at 640 px) so nothing is clamped.
-LensSettings blenderLens()
-{
-    LensSettings lens;
-    lens.model = CocModel::ThinLens;
-    lens.focalLengthMm = 85.0;
-    lens.fNumber = 1.4;
-    lens.focusM = 5.0;
-    lens.sensorWidthMm = 36.0;
-    lens.maxCocPx = 64.0;
-    return lens;
-}
-
 std::string shortLabel(const MethodInfo& info, const MethodSettings& s)
 {
     std::string base;
@@ -544,7 +530,7 @@ int run(const Options& options, const std::string& commandLine)
 {
     if (!options.replot.empty())
         return replot(options);
-    LensSettings lens = blenderLens();
+    LensSettings lens = blenderSpheresLens();
     lens.bladeRotationDeg = options.bladeRotationDeg;
     cv::Mat color, depth, truth;
     std::string sceneLabel = options.data;
@@ -556,7 +542,7 @@ int run(const Options& options, const std::string& commandLine)
         const std::string name = options.scene.size() > 10 ? options.scene.substr(10) : "spheres";
         SyntheticSettings settings;
         settings.frames = 1;
-        settings.lens = blenderLens(); // the truth's aperture has a corner up, as Cycles' does
+        settings.lens = blenderSpheresLens(); // the truth's aperture has a corner up, as Cycles' does
         settings.focusPull = false;
         SyntheticScene scene(syntheticScene(name), settings);
         const SyntheticImages images = scene.render(0);

@@ -5,8 +5,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "filter/Pipeline.hpp"
+#include "filter/methods/Method.hpp"
 #include "filter/methods/Presets.hpp"
+#include "filter/Pipeline.hpp"
 #include "sources/ImageIO.hpp"
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"
@@ -36,7 +37,7 @@ TEST_F(Accuracy, BalancedPresetIsCloserToTheLensThanBlendersDefocusNode)
     EXPECT_NEAR(unblurred, 16.5, 0.1);
 
     Pipeline pipeline;
-    const cv::Mat out = pipeline.run({color, depth, 0.0, 0, "blender"}, test::blenderSpheresLens(), presetSettings("balanced"),
+    const cv::Mat out = pipeline.run({color, depth, 0.0, 0, "blender"}, blenderSpheresLens(), presetSettings("balanced"),
                                      View::Composite, Encoding::Linear32F);
     EXPECT_TRUE(test::allFinite(out));
     const double psnr = psnrClipped(out, truth);
@@ -45,7 +46,7 @@ TEST_F(Accuracy, BalancedPresetIsCloserToTheLensThanBlendersDefocusNode)
     QualitySettings published;
     published.kernel = HexagonKernel::McIntoshMin;
     published.samples = 16;
-    LensSettings flatTop = test::blenderSpheresLens();
+    LensSettings flatTop = blenderSpheresLens();
     flatTop.bladeRotationDeg = 30.0;
     const double mcintosh =
         psnrClipped(pipeline.run({color, depth, 0.0, 0, "blender"}, flatTop, published, View::Composite,

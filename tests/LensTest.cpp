@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "filter/Lens.hpp"
+#include "filter/methods/Method.hpp"
 #include "filter/passes/HexBlurPass.hpp"
-#include "tests/TestSupport.hpp"
 
 namespace defocus {
 namespace {
@@ -15,7 +15,7 @@ namespace {
 /// The Blender scene's camera with max-coc at its limit, so that no figure below is clamped.
 LensSettings blenderLens()
 {
-    LensSettings lens = test::blenderSpheresLens();
+    LensSettings lens = blenderSpheresLens();
     lens.maxCocPx = 512.0;
     return lens;
 }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "filter/methods/Method.hpp"
 #include "filter/Metrics.hpp"
 #include "tests/TestSupport.hpp"
 
@@ -112,7 +113,7 @@ TEST(Metrics, RegionMasksPartitionTheImage)
 
 TEST(Metrics, CocMapFollowsTheLensModel)
 {
-    const LensSettings lens = test::blenderSpheresLens();
+    const LensSettings lens = blenderSpheresLens();
     const CocCoefficients k = cocCoefficients(lens, 640);
     cv::Mat depth(1, 3, CV_32FC1);
     depth.at<float>(0, 0) = 1.43f;

@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "filter/Lens.hpp"
+#include "filter/methods/Method.hpp"
 #include "sources/ImageIO.hpp"
 #include "sources/SyntheticSource.hpp"
 #include "tests/GLTestSupport.hpp"
@@ -409,7 +410,7 @@ TEST_F(SyntheticSceneGL, TheCyclesTruthAgreesOnCocSizeAndOrientation)
     // at 5 m, 36 mm over 640 px) measured in the Cycles truth, and a point at 25 m rendered by
     // the synthetic reference with the same lens (640 px wide, so the CoC is the same 14.9 px;
     // 48 rows are enough).
-    const LensSettings lens = test::blenderSpheresLens();
+    const LensSettings lens = blenderSpheresLens();
     const double coc = thinLensCocPixels(lens, 640, 25.0);
 
     const auto dir = test::dataDir() / "blender_spheres";

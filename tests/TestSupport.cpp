@@ -29,17 +29,6 @@ LensSettings lensWithFarCoc(double diameterPx)
     return lens;
 }
 
-LensSettings blenderSpheresLens()
-{
-    LensSettings lens;
-    lens.focalLengthMm = 85.0;
-    lens.fNumber = 1.4;
-    lens.focusM = 5.0;
-    lens.sensorWidthMm = 36.0;
-    lens.maxCocPx = 64.0;
-    return lens;
-}
-
 bool allFinite(const cv::Mat& m)
 {
     if (m.depth() != CV_32F && m.depth() != CV_64F && m.depth() != CV_16F)

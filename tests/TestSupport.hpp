@@ -17,9 +17,6 @@ std::filesystem::path scratchDir(const std::string& name);
 /// A lens whose CoC at 2 m depth is exactly `diameterPx`: the focal-range model focused at 1 m,
 /// blur reaching max-coc at the far limit, 2 m.
 LensSettings lensWithFarCoc(double diameterPx);
-/// The camera of data/blender_spheres: 85 mm, f/1.4, focus 5 m, 36 mm sensor; max-coc 64 px,
-/// above the scene's largest CoC at 640 px (46.6 px), so nothing is clamped.
-LensSettings blenderSpheresLens();
 /// True when every element of `m` (any depth, any channels) is finite.
 bool allFinite(const cv::Mat& m);
 

@@ -34,6 +34,18 @@ std::string describe(const MethodInfo& info, const MethodSettings& settings)
                        precisionName(settings.precision));
 }
 
+LensSettings blenderSpheresLens()
+{
+    LensSettings lens;
+    lens.model = CocModel::ThinLens;
+    lens.focalLengthMm = 85.0;
+    lens.fNumber = 1.4;
+    lens.focusM = 5.0;
+    lens.sensorWidthMm = 36.0;
+    lens.maxCocPx = 64.0;
+    return lens;
+}
+
 const std::vector<MethodInfo>& methodRegistry()
 {
     static const std::vector<MethodInfo> registry{
