@@ -12,10 +12,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "filter/ColorSpace.hpp"
-#include "filter/Metrics.hpp"
 #include "filter/methods/Method.hpp"
 #include "filter/methods/Presets.hpp"
 #include "filter/methods/ReferenceScatter.hpp"
+#include "filter/Metrics.hpp"
 #include "sources/ImageIO.hpp"
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"
@@ -39,6 +39,21 @@ MethodSettings settingsFor(const MethodInfo& info, Resolution resolution, Target
 {
     const int samples = info.samples.size() == 1 ? info.samples.front() : QualitySettings{}.samples;
     return {samples, resolution, precision};
+}
+
+/// Runs every GPU method on `frame` at both resolutions and both precisions and hands each
+/// linear output to `check(info, settings, output)`.
+template <typename Check>
+void forEveryGpuSetting(const Frame& frame, const LensSettings& lens, Check check)
+{
+    for (const MethodInfo* info : gpuMethods()) {
+        auto method = createMethod(info->name);
+        for (const Resolution resolution : {Resolution::Full, Resolution::Half})
+            for (const TargetFormat precision : {TargetFormat::Rgba16F, TargetFormat::Rgba32F}) {
+                const MethodSettings settings = settingsFor(*info, resolution, precision);
+                check(*info, settings, method->run(frame, lens, settings).linear);
+            }
+    }
 }
 
 TEST_F(Methods, RegistryNamesAreUniqueAndCreatable)
@@ -95,22 +110,16 @@ TEST_F(Methods, FlatColourStaysFlatUnderBlur)
     LensSettings lens;
     lens.focusM = 2.0;
     lens.fNumber = 1.4;
-    for (const MethodInfo* info : gpuMethods()) {
-        auto method = createMethod(info->name);
-        for (const Resolution resolution : {Resolution::Full, Resolution::Half})
-            for (const TargetFormat precision : {TargetFormat::Rgba16F, TargetFormat::Rgba32F}) {
-                const MethodSettings settings = settingsFor(*info, resolution, precision);
-                const cv::Mat out = method->run(frame, lens, settings).linear;
-                cv::Mat diff;
-                cv::absdiff(out, cv::Scalar(flat[0], flat[1], flat[2]), diff);
-                double maxDiff = 0;
-                cv::minMaxLoc(diff.reshape(1), nullptr, &maxDiff);
-                // Half float keeps 11 significant bits: 0.8 is held to within 2^-11 * 0.8 = 4e-4,
-                // and a weighted average of such values stays within a few of those steps.
-                const double tolerance = precision == TargetFormat::Rgba16F ? 2e-3 : 1e-5;
-                EXPECT_LE(maxDiff, tolerance) << describe(*info, settings);
-            }
-    }
+    forEveryGpuSetting(frame, lens, [&](const MethodInfo& info, const MethodSettings& settings, const cv::Mat& out) {
+        cv::Mat diff;
+        cv::absdiff(out, cv::Scalar(flat[0], flat[1], flat[2]), diff);
+        double maxDiff = 0;
+        cv::minMaxLoc(diff.reshape(1), nullptr, &maxDiff);
+        // Half float keeps 11 significant bits: 0.8 is held to within 2^-11 * 0.8 = 4e-4,
+        // and a weighted average of such values stays within a few of those steps.
+        const double tolerance = settings.precision == TargetFormat::Rgba16F ? 2e-3 : 1e-5;
+        EXPECT_LE(maxDiff, tolerance) << describe(info, settings);
+    });
 }
 
 TEST_F(Methods, BadInputGivesNoNanOrInf)
@@ -130,14 +139,9 @@ TEST_F(Methods, BadInputGivesNoNanOrInf)
     LensSettings lens;
     lens.focusM = 2.0;
     lens.fNumber = 1.4;
-    for (const MethodInfo* info : gpuMethods()) {
-        auto method = createMethod(info->name);
-        for (const Resolution resolution : {Resolution::Full, Resolution::Half})
-            for (const TargetFormat precision : {TargetFormat::Rgba16F, TargetFormat::Rgba32F}) {
-                const MethodSettings settings = settingsFor(*info, resolution, precision);
-                EXPECT_TRUE(test::allFinite(method->run(frame, lens, settings).linear)) << describe(*info, settings);
-            }
-    }
+    forEveryGpuSetting(frame, lens, [](const MethodInfo& info, const MethodSettings& settings, const cv::Mat& out) {
+        EXPECT_TRUE(test::allFinite(out)) << describe(info, settings);
+    });
     auto reference = createMethod("reference");
     EXPECT_TRUE(test::allFinite(reference->run(frame, lens, {}).linear));
 }
@@ -199,7 +203,7 @@ TEST_F(Methods, ReferenceBeatsEveryGpuMethodOnTheBlenderScene)
     const cv::Mat truth = readColor(dir / "truth_f1.4_focus5_linear.exr");
     ASSERT_EQ(color.size(), cv::Size(640, 480));
     const Frame frame{color, depth, 0.0, 0, "blender"};
-    const LensSettings lens = test::blenderSpheresLens();
+    const LensSettings lens = blenderSpheresLens();
 
     // The reference runs at full size: it took 4-17 s for 640x480 on the 2-core development
     // machine (depending on other load), inside the 30 s this test allows it.
