@@ -2,11 +2,7 @@
 // message names the frame's file, the exit status is 1, and the frames before it are kept as
 // complete files (a shorter but playable video, or the sequence's first frames), with no
 // temporary file left. Needs an EGL context to render the frames before the failure.
-#include <sys/wait.h>
-
 #include <algorithm>
-#include <array>
-#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -25,26 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-    int exitCode = -1;
-    std::string output; // stdout and stderr
-};
-
-CliResult runDefocus(const std::string& arguments)
-{
-    const fs::path binary = fs::path(DEFOCUS_BINARY_DIR) / "defocus";
-    EXPECT_TRUE(fs::exists(binary)) << binary << " is missing: build the 'defocus' target first";
-    CliResult result;
-    FILE* pipe = ::popen(fmt::format("'{}' {} 2>&1", binary.string(), arguments).c_str(), "r");
-    if (!pipe)
-        return result;
-    std::array<char, 4096> chunk{};
-    while (std::fgets(chunk.data(), static_cast<int>(chunk.size()), pipe))
-        result.output += chunk.data();
-    const int status = ::pclose(pipe);
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return result;
-}
+using test::CliResult;
+using test::runDefocus;
 
 std::vector<std::string> fileNames(const fs::path& dir)
 {

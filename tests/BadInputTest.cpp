@@ -2,11 +2,7 @@
 // names the file (and line or frame), through the library and through the defocus binary, and
 // leaves no output behind. The cases that need frames rendered before the failure are in
 // BadInputGLTest.cpp.
-#include <sys/wait.h>
-
 #include <algorithm>
-#include <array>
-#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
@@ -382,26 +378,8 @@ TEST(BadVideo, TruncatedMkvEndsEarlyWithAWarningNamingBothCounts)
 
 // ---- The defocus binary ------------------------------------------------------------------------
 
-struct CliResult {
-    int exitCode = -1;
-    std::string output; // stdout and stderr
-};
-
-CliResult runDefocus(const std::string& arguments)
-{
-    const fs::path binary = fs::path(DEFOCUS_BINARY_DIR) / "defocus";
-    EXPECT_TRUE(fs::exists(binary)) << binary << " is missing: build the 'defocus' target first";
-    CliResult result;
-    FILE* pipe = ::popen(fmt::format("'{}' {} 2>&1", binary.string(), arguments).c_str(), "r");
-    if (!pipe)
-        return result;
-    std::array<char, 4096> chunk{};
-    while (std::fgets(chunk.data(), static_cast<int>(chunk.size()), pipe))
-        result.output += chunk.data();
-    const int status = ::pclose(pipe);
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return result;
-}
+using test::CliResult;
+using test::runDefocus;
 
 std::string quoted(const fs::path& path)
 {

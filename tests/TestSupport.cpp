@@ -1,13 +1,36 @@
 // Helpers shared by the tests.
 #include "tests/TestSupport.hpp"
 
+#include <array>
+#include <cstdio>
 #include <cstdlib>
+
+#include <sys/wait.h>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
 
 namespace defocus::test {
 
 std::filesystem::path dataDir()
 {
     return DEFOCUS_DATA_DIR;
+}
+
+CliResult runDefocus(const std::string& arguments)
+{
+    const std::filesystem::path binary = std::filesystem::path(DEFOCUS_BINARY_DIR) / "defocus";
+    EXPECT_TRUE(std::filesystem::exists(binary)) << binary << " is missing: build the 'defocus' target first";
+    CliResult result;
+    FILE* pipe = ::popen(fmt::format("'{}' {} 2>&1", binary.string(), arguments).c_str(), "r");
+    if (!pipe)
+        return result;
+    std::array<char, 4096> chunk{};
+    while (std::fgets(chunk.data(), static_cast<int>(chunk.size()), pipe))
+        result.output += chunk.data();
+    const int status = ::pclose(pipe);
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return result;
 }
 
 std::filesystem::path scratchDir(const std::string& name)
