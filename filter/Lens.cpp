@@ -54,13 +54,6 @@ CocCoefficients cocCoefficients(const LensSettings& lens, int imageWidthPx)
     return k;
 }
 
-float cocPixels(const CocCoefficients& k, float depthM)
-{
-    const float x = k.inverseDepth ? 1.0f / depthM : depthM;
-    const float c = depthM < k.focusM ? k.nearScale * x + k.nearOffset : k.farScale * x + k.farOffset;
-    return std::clamp(c, -k.maxCocPx, k.maxCocPx);
-}
-
 double thinLensCocPixels(const LensSettings& lens, int imageWidthPx, double depthM)
 {
     const double f = lens.focalLengthMm * 1e-3;

@@ -2,6 +2,8 @@
 // The CPU derives two multiply-add coefficients; the CoC shader only evaluates them.
 #pragma once
 
+#include <algorithm>
+
 #include "filter/Settings.hpp"
 
 namespace defocus {
@@ -23,8 +25,14 @@ struct CocCoefficients {
 /// `lens` must have passed validate().
 CocCoefficients cocCoefficients(const LensSettings& lens, int imageWidthPx);
 
-/// Evaluates the model exactly as the shader does (for tests and CPU tools).
-float cocPixels(const CocCoefficients& k, float depthM);
+/// Evaluates the model exactly as the shader does (for tests and CPU tools; inline, for the
+/// scene analysis' per-pixel loop).
+inline float cocPixels(const CocCoefficients& k, float depthM)
+{
+    const float x = k.inverseDepth ? 1.0f / depthM : depthM;
+    const float c = depthM < k.focusM ? k.nearScale * x + k.nearOffset : k.farScale * x + k.farOffset;
+    return std::clamp(c, -k.maxCocPx, k.maxCocPx);
+}
 
 /// The thin-lens CoC in pixels before clamping, straight from the textbook formula
 /// c = A |S2 - S1| / S2 * f / (S1 - f), signed; a reference for the derived coefficients.

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -23,30 +26,50 @@ bool SceneAnalysis::tileNeedsBlur(int x, int y, float sharpBelowPx) const
 SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k,
                            double invalidDepthFraction)
 {
-    CV_Assert(filledDepth.type() == CV_32FC1 && filledDepth.size() == color.size());
+    CV_Assert(filledDepth.type() == CV_32FC1 && filledDepth.size() == color.size() &&
+              (color.type() == CV_8UC3 || color.type() == CV_32FC3));
     SceneAnalysis a;
     constexpr int T = SceneAnalysis::kTileSize;
     a.tiles = {(filledDepth.cols + T - 1) / T, (filledDepth.rows + T - 1) / T};
     a.invalidDepthFraction = invalidDepthFraction;
 
     // CoC is monotonic in depth, so the tile's CoC range is the CoC of its depth range; only
-    // the histogram needs a CoC per pixel.
-    cv::Mat tileMinZ(a.tiles, CV_32F, cv::Scalar(std::numeric_limits<float>::max()));
-    cv::Mat tileMaxZ(a.tiles, CV_32F, cv::Scalar(std::numeric_limits<float>::lowest()));
-    for (int y = 0; y < filledDepth.rows; ++y) {
-        const float* z = filledDepth.ptr<float>(y);
-        float* lo = tileMinZ.ptr<float>(y / T);
-        float* hi = tileMaxZ.ptr<float>(y / T);
-        for (int x = 0; x < filledDepth.cols; ++x) {
-            lo[x / T] = std::min(lo[x / T], z[x]);
-            hi[x / T] = std::max(hi[x / T], z[x]);
-            const float c = std::abs(cocPixels(k, z[x]));
-            const auto bin = std::upper_bound(SceneAnalysis::kHistogramEdges.begin(),
-                                              SceneAnalysis::kHistogramEdges.end(), c) -
-                             SceneAnalysis::kHistogramEdges.begin();
-            ++a.histogram[static_cast<std::size_t>(bin)];
+    // the histogram needs a CoC per pixel. Rows of tiles are independent: OpenCV's threads take
+    // them in bands (the GPU is idle while this runs), each band with its own histogram.
+    cv::Mat tileMinZ(a.tiles, CV_32F), tileMaxZ(a.tiles, CV_32F);
+    constexpr std::size_t kBins = SceneAnalysis::kHistogramEdges.size() + 1;
+    std::vector<std::array<int, kBins>> bandHistograms(static_cast<std::size_t>(a.tiles.height));
+    cv::parallel_for_(cv::Range(0, a.tiles.height), [&](const cv::Range& range) {
+        for (int ty = range.start; ty < range.end; ++ty) {
+            float* lo = tileMinZ.ptr<float>(ty);
+            float* hi = tileMaxZ.ptr<float>(ty);
+            std::fill(lo, lo + a.tiles.width, std::numeric_limits<float>::max());
+            std::fill(hi, hi + a.tiles.width, std::numeric_limits<float>::lowest());
+            std::array<int, kBins>& histogram = bandHistograms[static_cast<std::size_t>(ty)];
+            histogram.fill(0);
+            for (int y = ty * T; y < std::min((ty + 1) * T, filledDepth.rows); ++y) {
+                const float* z = filledDepth.ptr<float>(y);
+                for (int tx = 0; tx < a.tiles.width; ++tx) {
+                    float tileLo = lo[tx], tileHi = hi[tx];
+                    for (int x = tx * T; x < std::min((tx + 1) * T, filledDepth.cols); ++x) {
+                        tileLo = std::min(tileLo, z[x]);
+                        tileHi = std::max(tileHi, z[x]);
+                        // The bin: how many edges |CoC| reaches (std::upper_bound's index).
+                        const float c = std::abs(cocPixels(k, z[x]));
+                        std::size_t bin = 0;
+                        for (const float edge : SceneAnalysis::kHistogramEdges)
+                            bin += c >= edge ? 1 : 0;
+                        ++histogram[bin];
+                    }
+                    lo[tx] = tileLo;
+                    hi[tx] = tileHi;
+                }
+            }
         }
-    }
+    });
+    for (const auto& band : bandHistograms)
+        for (std::size_t bin = 0; bin < kBins; ++bin)
+            a.histogram[bin] += band[bin];
     a.tileMinCoc.create(a.tiles, CV_32F);
     a.tileMaxCoc.create(a.tiles, CV_32F);
     a.minCoc = std::numeric_limits<float>::max();
@@ -72,17 +95,27 @@ SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, con
                    cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
     }
 
-    cv::Mat bright;
-    if (color.depth() == CV_8U) {
-        cv::Mat channelMax;
-        cv::reduce(color.reshape(1, static_cast<int>(color.total())), channelMax, 1, cv::REDUCE_MAX);
-        bright = channelMax >= 250;
-    } else {
-        cv::Mat luminance;
-        cv::transform(color, luminance, cv::Matx13f(0.0722f, 0.7152f, 0.2126f)); // BGR Rec.709
-        bright = luminance > 1.0f;
-    }
-    a.highlightFraction = static_cast<double>(cv::countNonZero(bright)) / static_cast<double>(color.total());
+    // Highlights: 8-bit, any channel clipped (>= 250); float, luminance above 1. In bands too.
+    std::vector<int> bandBright(static_cast<std::size_t>(color.rows), 0);
+    cv::parallel_for_(cv::Range(0, color.rows), [&](const cv::Range& range) {
+        for (int y = range.start; y < range.end; ++y) {
+            int count = 0;
+            if (color.depth() == CV_8U) {
+                const std::uint8_t* p = color.ptr<std::uint8_t>(y);
+                for (int x = 0; x < color.cols; ++x, p += 3)
+                    count += std::max(p[0], std::max(p[1], p[2])) >= 250 ? 1 : 0;
+            } else {
+                const float* p = color.ptr<float>(y);
+                for (int x = 0; x < color.cols; ++x, p += 3) // BGR, Rec.709 luminance
+                    count += 0.0722f * p[0] + 0.7152f * p[1] + 0.2126f * p[2] > 1.0f ? 1 : 0;
+            }
+            bandBright[static_cast<std::size_t>(y)] = count;
+        }
+    });
+    std::size_t bright = 0;
+    for (const int count : bandBright)
+        bright += static_cast<std::size_t>(count);
+    a.highlightFraction = static_cast<double>(bright) / static_cast<double>(color.total());
     return a;
 }
 
