@@ -20,6 +20,7 @@
 #include "filter/passes/HexBlurPass.hpp"
 #include "filter/passes/RhombusBlurPass.hpp"
 #include "filter/passes/NearBlurPass.hpp"
+#include "filter/passes/UpscalePass.hpp"
 #include "filter/passes/ViewPass.hpp"
 
 namespace defocus {
@@ -103,8 +104,11 @@ struct Pipeline::Impl {
     CompositePass compositePass;
     CopyPass copyPass;
     NearBlurPass nearBlurPass;
+    UpscalePass upscalePass;
     ViewPass viewPass;
     TileList blurTiles, copyTiles, nearTiles;
+    TileList detailTiles; ///< Resolution::Half: where the upscale puts the frame's detail back
+    bool upscaleUsesTiles = false;
     gl::GpuTimer timer;
 
     gl::Texture colorTexture;
@@ -114,9 +118,14 @@ struct Pipeline::Impl {
     Target horizontalMean;
     TargetPair firstPair, secondPair;
     Target nearHorizontal, nearA, nearB; ///< the foreground layer's blurs
+    Target blurred;   ///< Resolution::Half: the half-size result, upscaled into the output
+    Target sharpened, added; ///< Resolution::Half: the result prefiltered for the upscale
+    TargetPair prefiltered;
     gl::Texture nearDiameter;            ///< per tile, R32F
 
-    cv::Size size;
+    cv::Size size;     ///< the frame's
+    cv::Size blurSize; ///< the blur passes': the frame's, or half of it (Resolution::Half)
+    int blurShift = 0; ///< log2 of size / blurSize
     PreparedDepth prepared;
     float maxCocPx = 0.0f;
     FrameTimings timings;
@@ -154,6 +163,10 @@ struct Pipeline::Impl {
     }
     void uploadNearDiameter();
     void prepareDepthAndPlan();
+    /// The analysis' tiles in the blur passes' pixels.
+    int tileSize() const { return SceneAnalysis::kTileSize >> blurShift; }
+    /// Half size: the blurred result into `blurred`, then upscaled with the frame into `out`.
+    void upscale(const gl::Framebuffer& out);
 
     explicit Impl(bool timers) : timer(timers) {}
 
@@ -190,6 +203,8 @@ Pipeline::Pipeline(bool timers)
         run({color, depth, 0.0, 0, "warm-up"}, lens, quality, view, Encoding::Srgb8);
         run({color, depth, 0.0, 0, "warm-up"}, lens, quality, view, Encoding::Linear32F);
     }
+    quality.resolution = Resolution::Half;
+    run({color, depth, 0.0, 0, "warm-up"}, lens, quality, View::Composite, Encoding::Srgb8);
     drainGpuTimes();
     impl_->timings = {};
 }
@@ -203,6 +218,8 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     p.timings = {};
     p.frameStart = Clock::now();
     p.size = frame.color.size();
+    p.blurShift = quality.resolution == Resolution::Half ? 1 : 0;
+    p.blurSize = {(p.size.width + p.blurShift) >> p.blurShift, (p.size.height + p.blurShift) >> p.blurShift};
 
     auto start = Clock::now();
     p.color = frame.color;
@@ -249,7 +266,7 @@ void Pipeline::Impl::prepareDepthAndPlan()
     depthPrepared = true;
     analysis = analyseScene(prepared.metres, color, coefficients, prepared.invalidFraction);
     const bool allInFocus = plan.allInFocus && quality.adaptive;
-    plan = makePlan(analysis, quality.nearField, quality.kernel);
+    plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution);
     if (color.type() == CV_8UC3 && plan.highlights && !plan.allInFocus)
         plan.highlightGain = quality.highlightGain;
     plan.allInFocus = plan.allInFocus || allInFocus;
@@ -259,15 +276,21 @@ void Pipeline::Impl::uploadNearDiameter()
 {
     ensureTexture(nearDiameter, GL_R32F, analysis.tiles, "near diameter per tile");
     CV_Assert(analysis.tileNearDiameter.isContinuous());
-    nearDiameter.upload(GL_RED, GL_FLOAT, analysis.tileNearDiameter.data);
+    if (blurShift == 0) {
+        nearDiameter.upload(GL_RED, GL_FLOAT, analysis.tileNearDiameter.data);
+    } else {
+        // The analysis measured the frame's pixels; the blur counts half-size ones.
+        const cv::Mat scaled = analysis.tileNearDiameter * (1.0 / (1 << blurShift));
+        nearDiameter.upload(GL_RED, GL_FLOAT, scaled.data);
+    }
 }
 
 void Pipeline::Impl::renderMcIntosh(bool useTiles)
 {
     const GLenum format = coc.texture.format();
-    horizontal.ensure(format, size, "horizontal");
-    diagonalA.ensure(format, size, "diagonal A");
-    diagonalB.ensure(format, size, "diagonal B");
+    horizontal.ensure(format, blurSize, "horizontal");
+    diagonalA.ensure(format, blurSize, "diagonal A");
+    diagonalB.ensure(format, blurSize, "diagonal B");
     // McIntosh et al.'s first pass runs along an edge of the hexagon. Edges and corners point
     // the same ways (mod 60 deg), so the edge nearest an axis is the rhombi's u1: with a corner
     // on top (rotation 0) the edges are vertical and the passes run at 90 and 90 +- 120 deg; with
@@ -285,11 +308,11 @@ void Pipeline::Impl::renderMcIntosh(bool useTiles)
     blur("diagonal-b", horizontal.texture, first - 120.0f, diagonalB);
 
     if (plan.nearField) {
-        nearHorizontal.ensure(format, size, "near horizontal");
-        nearA.ensure(format, size, "near A");
-        nearB.ensure(format, size, "near B");
+        nearHorizontal.ensure(format, blurSize, "near horizontal");
+        nearA.ensure(format, blurSize, "near A");
+        nearB.ensure(format, blurSize, "near B");
         uploadNearDiameter();
-        nearTiles.set(plan.nearTiles, size, SceneAnalysis::kTileSize);
+        nearTiles.set(plan.nearTiles, blurSize, tileSize());
         timer.begin("near-field");
         nearBlurPass.run(coc.texture, nearDiameter, first, quality.samples, true, nearHorizontal.framebuffer, nearTiles);
         nearBlurPass.run(nearHorizontal.texture, nearDiameter, first + 120.0f, quality.samples, false,
@@ -305,10 +328,10 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
     const GLenum format = coc.texture.format();
     // The McIntosh passes share horizontal and the diagonals, and may have remade them since:
     // the pairs follow the textures' generations, not this function's own calls.
-    horizontal.ensure(format, size, "horizontal / rhombi X");
-    horizontalMean.ensure(format, size, "rhombi Y");
-    diagonalA.ensure(format, size, "diagonal A / rhombi A");
-    diagonalB.ensure(format, size, "diagonal B / rhombi B");
+    horizontal.ensure(format, blurSize, "horizontal / rhombi X");
+    horizontalMean.ensure(format, blurSize, "rhombi Y");
+    diagonalA.ensure(format, blurSize, "diagonal A / rhombi A");
+    diagonalB.ensure(format, blurSize, "diagonal B / rhombi B");
     const gl::Framebuffer& first = firstPair.of(horizontal, horizontalMean, "rhombi pass 1");
     const gl::Texture* near = nullptr;
     if (plan.nearField) {
@@ -318,8 +341,7 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
     const auto directions = RhombusBlurPass::directions(bladeRotationDeg);
     const TileList* tiles = useTiles ? &blurTiles : nullptr;
     timer.begin("rhombi-1");
-    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, directions, quality.samples,
-                        SceneAnalysis::kTileSize, tiles);
+    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, directions, quality.samples, tileSize(), tiles);
     if (useTiles)
         copyPass.run(coc.texture, copyTiles, first, true);
     timer.end();
@@ -336,14 +358,44 @@ void Pipeline::Impl::rhombiSecondPass(const gl::Framebuffer* fusedTarget)
     glBindVertexArray(vao.id());
     timer.begin("rhombi-2");
     rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, target}, false,
-                        RhombusBlurPass::directions(bladeRotationDeg), quality.samples, SceneAnalysis::kTileSize,
-                        tiles, fusedTarget != nullptr);
+                        RhombusBlurPass::directions(bladeRotationDeg), quality.samples, tileSize(), tiles,
+                        fusedTarget != nullptr);
     if (rhombiUsesTiles)
         copyPass.run(horizontal.texture, copyTiles, target, fusedTarget == nullptr);
     timer.end();
     if (!fusedTarget) {
         rhombiSecondPending = false; // A and B hold this frame now
     }
+}
+
+void Pipeline::Impl::upscale(const gl::Framebuffer& out)
+{
+    assert(blurShift != 0);
+    blurred.ensure(coc.texture.format(), blurSize, "half-size result");
+    if (rhombiSecondPending) {
+        rhombiSecondPass(&blurred.framebuffer);
+    } else {
+        timer.begin(CompositePass::kName);
+        const bool near = plan.nearField;
+        if (quality.kernel == HexagonKernel::RhombiSum)
+            compositePass.runSum(diagonalA.texture, diagonalB.texture, blurred.framebuffer);
+        else
+            compositePass.run(diagonalA.texture, diagonalB.texture, blurred.framebuffer,
+                              near ? &nearA.texture : nullptr, near ? &nearB.texture : nullptr);
+        timer.end();
+    }
+    sharpened.ensure(coc.texture.format(), blurSize, "half-size result, sharpened");
+    added.ensure(coc.texture.format(), blurSize, "half-size result minus input");
+    const UpscalePass::Io io{colorTexture,     depth,         coc.texture,
+                             blurred.texture,  sharpened.texture, added.texture,
+                             prefiltered.of(sharpened, added, "upscale prefilter"), out};
+    timer.begin(UpscalePass::kPrefilterName);
+    upscalePass.prefilter(io);
+    timer.end();
+    timer.begin(UpscalePass::kName);
+    upscalePass.upscale(io, coefficients, quality.targetFormat == TargetFormat::Rgba16F,
+                        upscaleUsesTiles ? &detailTiles : nullptr);
+    timer.end();
 }
 
 void Pipeline::Impl::render()
@@ -361,7 +413,7 @@ void Pipeline::Impl::render()
 
     start = Clock::now();
     const bool half = quality.targetFormat == TargetFormat::Rgba16F;
-    coc.ensure(half ? GL_RGBA16F : GL_RGBA32F, size, "coc");
+    coc.ensure(half ? GL_RGBA16F : GL_RGBA32F, blurSize, "coc");
 
     // Tiles in focus are copied, not blurred, when enough of them are: a thousand small quads
     // cost the rasteriser more than one full-screen triangle (on llvmpipe, drawing 1181 of 1200
@@ -369,13 +421,19 @@ void Pipeline::Impl::render()
     const bool useTiles = quality.adaptive && !plan.copyTiles.empty() &&
                           plan.copyTiles.size() * 4 >= plan.copyTiles.size() + plan.blurTiles.size();
     if (useTiles) {
-        blurTiles.set(plan.blurTiles, size, SceneAnalysis::kTileSize);
-        copyTiles.set(plan.copyTiles, size, SceneAnalysis::kTileSize);
+        blurTiles.set(plan.blurTiles, blurSize, tileSize());
+        copyTiles.set(plan.copyTiles, blurSize, tileSize());
     }
+    // The upscale's detail on tiles by the same rule: when a quarter of them only interpolate.
+    upscaleUsesTiles = quality.adaptive && blurShift != 0 &&
+                       plan.detailTiles.size() * 4 <= static_cast<std::size_t>(analysis.tiles.area()) * 3;
+    if (upscaleUsesTiles)
+        detailTiles.set(plan.detailTiles, size, SceneAnalysis::kTileSize);
     glBindVertexArray(vao.id());
     timer.begin(CocPass::kName);
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
-    cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain));
+    cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
+                blurShift != 0);
     timer.end();
     rhombiSecondPending = false;
     if (quality.kernel == HexagonKernel::RhombiSum)
@@ -415,11 +473,15 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
 
     glBindVertexArray(p.vao.id());
     float low = 0.0f, high = 0.0f;
-    const bool fused = view == View::Composite && p.rhombiSecondPending;
+    const bool fused = view == View::Composite && (p.rhombiSecondPending || p.blurShift != 0);
     if (fused) {
         // Rhombi: pass 2 with the composite in it, into the output (no A and B targets); its
-        // timer scope is "rhombi-2", and no "composite" runs.
-        p.rhombiSecondPass(&out.framebuffer);
+        // timer scope is "rhombi-2", and no "composite" runs. At half size, the result goes to
+        // the half-size target and the upscale makes the output.
+        if (p.blurShift != 0)
+            p.upscale(out.framebuffer);
+        else
+            p.rhombiSecondPass(&out.framebuffer);
     } else if (view == View::Composite) {
         p.timer.begin(CompositePass::kName);
         const bool near = p.plan.nearField;
@@ -439,7 +501,7 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
             high = static_cast<float>(std::max(hi, lo * 1.01 + 1e-3));
             p.viewPass.run(p.depth, ViewPass::Mode::Depth, low, high, out.framebuffer);
         } else if (view == View::Coc) {
-            high = p.maxCocPx;
+            high = p.maxCocPx / static_cast<float>(1 << p.blurShift); // the target's pixels
             p.viewPass.run(p.coc.texture, ViewPass::Mode::Coc, 0.0f, high, out.framebuffer);
         } else {
             p.viewPass.run(p.target(view).texture, ViewPass::Mode::Color, 0.0f, 0.0f, out.framebuffer);
@@ -483,7 +545,7 @@ cv::Mat Pipeline::readTarget(View view) const
     if (view == View::DiagonalA || view == View::DiagonalB)
         impl_->ensureDiagonals();
     const Target& target = impl_->target(view);
-    cv::Mat image(impl_->size, CV_32FC4);
+    cv::Mat image(target.texture.height(), target.texture.width(), CV_32FC4);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, target.framebuffer.id());
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, image.cols, image.rows, GL_RGBA, GL_FLOAT, image.data);

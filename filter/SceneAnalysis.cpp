@@ -119,7 +119,7 @@ SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, con
     return a;
 }
 
-FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel kernel)
+FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel kernel, Resolution resolution)
 {
     FramePlan plan;
     plan.allInFocus = analysis.maxAbsCoc() < 0.5f;
@@ -141,7 +141,16 @@ FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel 
             // The rhombus blur handles the foreground itself: tiles it reaches are blurred too.
             const bool blur = analysis.tileNeedsBlur(x, y, sharpBelow) || (near && kernel == HexagonKernel::RhombiSum);
             (blur ? plan.blurTiles : plan.copyTiles).emplace_back(x, y);
+            if (resolution == Resolution::Half) {
+                // upscale.frag's detail weight is 0 from |CoC| = 2 px: a tile whose whole range
+                // lies beyond has nothing to put back.
+                const bool detail = analysis.tileMinCoc.at<float>(y, x) < kUpscaleDetailBelowPx &&
+                                    analysis.tileMaxCoc.at<float>(y, x) > -kUpscaleDetailBelowPx;
+                if (detail)
+                    plan.detailTiles.emplace_back(x, y);
+            }
         }
+    plan.resolution = resolution;
     return plan;
 }
 
@@ -156,6 +165,8 @@ std::string FramePlan::explain(const SceneAnalysis& analysis) const
                                                 analysis.maxCoc);
     if (allInFocus)
         return text + " (hole filling and analysis skipped)";
+    if (resolution == Resolution::Half)
+        text += fmt::format("; half size, upscale puts detail back on {}/{} tiles", detailTiles.size(), total);
     text += holeFill ? fmt::format("; hole fill on ({:.1f} % invalid)", 100.0 * analysis.invalidDepthFraction)
                      : "; hole fill off (no holes)";
     text += nearField ? fmt::format("; near field on {} tiles", nearTiles.size())

@@ -12,6 +12,10 @@
 
 namespace defocus {
 
+/// Resolution::Half: the upscale (upscale.frag) puts the frame's own pixels back under this
+/// |CoC|, fully up to half of it and fading out to it.
+inline constexpr float kUpscaleDetailBelowPx = 2.0f;
+
 struct SceneAnalysis {
     static constexpr int kTileSize = 16; ///< pixels per tile side
     /// Upper edges of the |CoC| histogram bins, pixels; the last bin takes the rest.
@@ -52,6 +56,10 @@ struct FramePlan {
     bool nearField = false;           ///< the foreground layer passes run
     std::vector<cv::Point> nearTiles; ///< tiles the foreground layer covers
     HexagonKernel kernel = HexagonKernel::McIntoshMin; ///< the blur passes' kind, for explain()
+    /// Resolution::Half: the tiles with pixels under 2 px of CoC, where the upscale puts the
+    /// frame's own detail back (upscale.frag); on the others it only interpolates the blur.
+    std::vector<cv::Point> detailTiles;
+    Resolution resolution = Resolution::Full; ///< the blur passes' size, for explain()
     /// Gain of the 8-bit highlight recovery in the CoC pass; 1 = not run (set by the pipeline).
     double highlightGain = 1.0;
 
@@ -61,7 +69,8 @@ struct FramePlan {
 
 /// `nearField`: spread foreground blur when the frame has some: McIntosh runs the foreground
 /// layer on nearTiles; the rhombus blur reaches over them itself, so they join blurTiles.
+/// `resolution` Half also sorts the tiles for the upscale (detailTiles).
 FramePlan makePlan(const SceneAnalysis& analysis, bool nearField = true,
-                   HexagonKernel kernel = HexagonKernel::McIntoshMin);
+                   HexagonKernel kernel = HexagonKernel::McIntoshMin, Resolution resolution = Resolution::Full);
 
 } // namespace defocus

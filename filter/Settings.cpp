@@ -92,6 +92,21 @@ std::vector<SettingIssue> validate(QualitySettings& quality, bool clamp)
     return issues;
 }
 
+std::string_view resolutionName(Resolution resolution)
+{
+    return resolution == Resolution::Full ? "full" : "half";
+}
+
+bool parseResolution(std::string_view name, Resolution& resolution)
+{
+    for (const Resolution r : {Resolution::Full, Resolution::Half})
+        if (name == resolutionName(r)) {
+            resolution = r;
+            return true;
+        }
+    return false;
+}
+
 std::string_view kernelName(HexagonKernel kernel)
 {
     return kernel == HexagonKernel::McIntoshMin ? "mcintosh" : "rhombi";

@@ -47,6 +47,21 @@ enum class TargetFormat {
     Rgba32F  ///< full float
 };
 
+/// The size the blur passes run at. The CoC pass, the scene analysis and the output are always
+/// the frame's size.
+enum class Resolution {
+    Full, ///< every pass at the frame's size
+    /// The CoC pass averages 2x2 pixels into a (w + 1) / 2 x (h + 1) / 2 target (CoC in pixels
+    /// halves with the size), the blurs run there, and an upscale pass makes the frame-sized
+    /// output: the blurred result interpolated, with the frame's own pixels put back where they
+    /// are in focus (upscale.frag). About a quarter of the blur's cost.
+    Half
+};
+
+std::string_view resolutionName(Resolution resolution); ///< "full", "half"
+/// Parses a name as printed by resolutionName(); returns false when unknown.
+bool parseResolution(std::string_view name, Resolution& resolution);
+
 /// How the directional blurs make a hexagon.
 enum class HexagonKernel {
     /// McIntosh, Riecke & DiPaola 2012: blur along an edge direction (the one nearest an axis:
@@ -73,6 +88,8 @@ struct QualitySettings {
     int samples = 16;
     HexagonKernel kernel = HexagonKernel::RhombiSum;
     TargetFormat targetFormat = TargetFormat::Rgba16F;
+    /// Size of the blur passes (see Resolution).
+    Resolution resolution = Resolution::Full;
     /// Follow the per-frame plan: skip every pass when the frame is all in focus and blur only
     /// the tiles that need it. false runs every pass on every pixel (for comparisons).
     bool adaptive = true;

@@ -166,5 +166,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         HexagonKernel back = k == HexagonKernel::RhombiSum ? HexagonKernel::McIntoshMin : HexagonKernel::RhombiSum;
         FUZZ_CHECK(parseKernel(kernelName(k), back) && back == k, "kernel %d does not round-trip", static_cast<int>(k));
     }
+    Resolution resolution = Resolution::Full;
+    if (parseResolution(name, resolution))
+        FUZZ_CHECK(resolutionName(resolution) == name, "parseResolution('%s') gave '%s'", name.c_str(),
+                   std::string(resolutionName(resolution)).c_str());
+    for (const Resolution r : {Resolution::Full, Resolution::Half}) {
+        Resolution back = r == Resolution::Full ? Resolution::Half : Resolution::Full;
+        FUZZ_CHECK(parseResolution(resolutionName(r), back) && back == r, "resolution %d does not round-trip",
+                   static_cast<int>(r));
+    }
     return 0;
 }

@@ -54,9 +54,9 @@ struct Options {
     LensSettings lens;
     QualitySettings quality;
     std::string qualityPreset = std::string(kDefaultPreset);
-    bool halfResolution = false; ///< from a preset: blur at half size, upscale the result
     std::string model = "thin-lens";
     std::string precision = "16f";
+    std::string resolution = "full";
     std::string kernel = "rhombi";
     std::string view = "composite";
     std::string contactSheet;
@@ -163,19 +163,6 @@ private:
     std::vector<nlohmann::json> frames_;
 };
 
-/// Half-resolution frame for presets that blur at half size, as the accuracy benchmark measured
-/// them (filter/methods/Method.hpp): linear colour area-averaged, depth by nearest neighbour.
-Frame halfFrame(const Frame& frame)
-{
-    Frame half = frame;
-    const cv::Size size((frame.color.cols + 1) / 2, (frame.color.rows + 1) / 2);
-    const cv::Mat linear = frame.color.type() == CV_8UC3 ? decodeSrgb(frame.color) : frame.color;
-    cv::resize(linear, half.color, size, 0, 0, cv::INTER_AREA);
-    if (!frame.depth.empty())
-        cv::resize(frame.depth, half.depth, size, 0, 0, cv::INTER_NEAREST);
-    return half;
-}
-
 /// --demo: a synthetic scene's shot (docs/synthetic.md) through the command line's lens; with
 /// 'auto' focus, the focus follows the scene's focus pull.
 std::unique_ptr<SyntheticSource> openDemo(const Options& options)
@@ -250,16 +237,7 @@ int run(const Options& options)
                 if (const auto issues = validate(lens); !issues.empty())
                     throw std::runtime_error(fmt::format("automatic focus: {}", issues.front().message));
             }
-            cv::Mat image;
-            if (options.halfResolution) {
-                LensSettings halfLens = lens;
-                halfLens.maxCocPx *= 0.5;
-                cv::Mat linear = pipeline.run(halfFrame(*frame), halfLens, options.quality, view, Encoding::Linear32F);
-                cv::resize(linear, linear, frame->color.size(), 0, 0, cv::INTER_LINEAR);
-                image = encoding == Encoding::Linear32F ? linear : encodeSrgb(linear);
-            } else {
-                image = pipeline.run(*frame, lens, options.quality, view, encoding);
-            }
+            const cv::Mat image = pipeline.run(*frame, lens, options.quality, view, encoding);
             if (!options.contactSheet.empty() && frame->index == options.contactFrame) {
                 std::vector<std::pair<std::string, cv::Mat>> tiles;
                 int number = 1;
@@ -351,8 +329,8 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--quality", o.qualityPreset,
                    "Preset from the accuracy benchmark (docs/accuracy.md): fast (rhombi with near field, 6 taps, at "
-                   "half size), balanced (6 taps), high (12 taps); --samples, --precision, --hexagon and "
-                   "--near-field override it")
+                   "half size), balanced (6 taps), high (12 taps); --samples, --precision, --resolution, --hexagon "
+                   "and --near-field override it")
         ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
     app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
@@ -365,6 +343,10 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
         ->check(CLI::IsMember({"16f", "32f"}));
+    app.add_option("--resolution", o.resolution,
+                   "Size the blurs run at: full, or half (a quarter of the cost; the output keeps the frame's size "
+                   "and its in-focus pixels) [default: from --quality]")
+        ->check(CLI::IsMember({"full", "half"}));
     std::vector<std::string> views;
     for (const View v : kAllViews)
         views.emplace_back(viewName(v));
@@ -423,12 +405,14 @@ int main(int argc, char** argv)
                 o.kernel = std::string(kernelName(fromPreset.kernel));
             if (app.count("--near-field") == 0)
                 o.quality.nearField = fromPreset.nearField;
-            o.halfResolution = preset(o.qualityPreset).settings.resolution == Resolution::Half;
+            if (app.count("--resolution") == 0)
+                o.resolution = std::string(resolutionName(fromPreset.resolution));
         }
         o.quality.adaptive = !alwaysOn;
         o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
         o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
         parseKernel(o.kernel, o.quality.kernel);
+        parseResolution(o.resolution, o.quality.resolution);
         bool autoFocus = false;
         if (!parseFocus(o.focus, o.lens, autoFocus)) {
             spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);

@@ -49,8 +49,9 @@ struct Options {
     std::vector<std::string> sizes = {"640x480", "1920x1080"};
     int runs = 15;
     int warmup = 3;
-    std::string preset = "balanced";  ///< full-resolution presets only: the pipeline runs alone
+    std::string preset = "balanced";
     std::optional<int> samples;        ///< overrides the preset's
+    std::optional<std::string> resolution;
     std::optional<std::string> precision;
     std::optional<std::string> kernel; ///< "rhombi" or "mcintosh"
     std::optional<bool> nearField;
@@ -383,6 +384,8 @@ int run(const Options& options, const std::string& commandLine)
         quality.targetFormat = *options.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
     if (options.kernel)
         parseKernel(*options.kernel, quality.kernel);
+    if (options.resolution)
+        parseResolution(*options.resolution, quality.resolution);
     if (options.nearField)
         quality.nearField = *options.nearField;
     quality.adaptive = !options.noAdaptive;
@@ -418,10 +421,11 @@ int run(const Options& options, const std::string& commandLine)
     fmt::print("GL renderer: {}; GL {}; EGL platform: {}\nCPU: {}, {} cores; load average {:.2f} before the runs "
                "(figures are only comparable on an otherwise idle machine)\n",
                info.glRenderer, info.glVersion, info.platform, cpu, cores, loadBefore);
-    fmt::print("clip: {} ({} frames, cycled); --quality {}: {} {} taps{}, {}, {}; {} runs after {} warm-up frames "
-               "per scene\n",
+    fmt::print("clip: {} ({} frames, cycled); --quality {}: {} {} taps{}, {} size, {}, {}; {} runs after {} warm-up "
+               "frames per scene\n",
                options.data, clip.size(), options.preset, kernelName(quality.kernel), quality.samples,
-               quality.nearField ? " + near field" : "", precision == "32f" ? "RGBA32F" : "RGBA16F",
+               quality.nearField ? " + near field" : "", resolutionName(quality.resolution),
+               precision == "32f" ? "RGBA32F" : "RGBA16F",
                quality.adaptive ? "adaptive (in-focus frames and tiles skipped)" : "every pass on every pixel",
                options.runs, options.warmup);
     fmt::print("lens: thin lens {} mm f/{} focused at {} m, 36 mm sensor, max-coc {} px per 640 px of width\n",
@@ -495,6 +499,7 @@ int run(const Options& options, const std::string& commandLine)
               {"kernel", kernelName(quality.kernel)},
               {"nearField", quality.nearField},
               {"samples", quality.samples},
+              {"resolution", resolutionName(quality.resolution)},
               {"precision", precision},
               {"adaptive", quality.adaptive},
               {"focusM", options.focusM},
@@ -573,13 +578,14 @@ int main(int argc, char** argv)
     app.add_option("--warmup", o.warmup, "Unmeasured frames first, per size and scene")
         ->check(CLI::Range(0, 1000))
         ->capture_default_str();
-    app.add_option("--quality", o.preset, "Preset (docs/accuracy.md): balanced or high (fast runs at half size, "
-                                          "which the pipeline alone does not)")
-        ->check(CLI::IsMember({"balanced", "high"}))
+    app.add_option("--quality", o.preset, "Preset (docs/accuracy.md): fast, balanced or high")
+        ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
     app.add_option("--samples", o.samples, "Taps per directional blur, 2..64 [default: from --quality]");
     app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
         ->check(CLI::IsMember({"16f", "32f"}));
+    app.add_option("--resolution", o.resolution, "Size of the blurs: full or half [default: from --quality]")
+        ->check(CLI::IsMember({"full", "half"}));
     app.add_option("--hexagon", o.kernel, "rhombi or mcintosh [default: from --quality]")
         ->check(CLI::IsMember({"rhombi", "mcintosh"}));
     app.add_option("--near-field", o.nearField, "true or false [default: from --quality]");

@@ -1,24 +1,24 @@
 #version 450 core
 // CoC pass (McIntosh et al. 2012, pass 1): linear colour in rgb, signed circle-of-confusion
-// diameter in pixels in alpha (near < 0 < far). The CPU derived the madd coefficients
-// (filter/Lens.cpp); here c = scale * x + offset with x = 1/z for the thin lens, x = z for the
-// focal-range model.
+// diameter in pixels in alpha (near < 0 < far), from the frame's colour and filled depth
+// (coc_params.glsl).
+//
+// HALF_SIZE: the target is half the frame's size (Resolution::Half). Each texel takes the mean
+// colour of a 2x2 block of the frame and the CoC of the block's sharpest pixel (smallest |CoC|),
+// in pixels of the half-size image (half the frame's). A block across a depth edge then keeps
+// the sharper side's size: a silhouette in focus stays in focus (and the upscale puts its pixels
+// back), and the blend is not spread as far as the blurrier side would spread it. Measured on the
+// Blender scene (rhombi-near, 6 taps): 33.10 dB, against 33.01 for the top-left pixel's CoC (the
+// nearest-neighbour resize of the depth), 33.02 for the nearest pixel's and 32.91 for the mean.
+// The last row and column repeat on frames of odd size.
 #include "common.glsl"
+#include "coc_params.glsl"
 
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
 layout(binding = 0) uniform sampler2D uColor; // sRGB8 textures decode to linear on fetch
 layout(binding = 1) uniform sampler2D uDepth; // metres, holes already filled
-
-layout(std140, binding = 0) uniform CocParams {
-    vec4 coefficients; // nearScale, nearOffset, farScale, farOffset
-    float focusM;
-    float maxCocPx;
-    int inverseDepth;
-    float largestColor; // 65504 for half-float targets
-    float highlightGain; // 8-bit input: near-clipped pixels that get blurred are scaled up to this
-};
 
 // Highlights from 8-bit video (issue 6): a light clipped at 255 is far brighter than 1.0, and a
 // blur of its clipped value spreads a dull grey. Pixels whose brightest channel is within the
@@ -33,13 +33,26 @@ vec3 recoverHighlight(vec3 color, float coc)
     return color * mix(1.0, highlightGain, smoothstep(0.96, 1.0, peak));
 }
 
+// Colour (highlights recovered, sanitised) and CoC of one pixel of the frame.
+vec4 pixel(ivec2 texel)
+{
+    const vec3 color = texelFetch(uColor, texel, 0).rgb;
+    const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
+    return vec4(sanitizeColor(recoverHighlight(color, coc), largestColor), coc);
+}
+
 void main()
 {
     const ivec2 texel = ivec2(gl_FragCoord.xy);
-    const vec3 color = texelFetch(uColor, texel, 0).rgb;
-    const float z = texelFetch(uDepth, texel, 0).r;
-    const float x = inverseDepth != 0 ? 1.0 / z : z;
-    const vec2 k = z < focusM ? coefficients.xy : coefficients.zw;
-    const float coc = clamp(k.x * x + k.y, -maxCocPx, maxCocPx);
-    outColor = vec4(sanitizeColor(recoverHighlight(color, coc), largestColor), coc);
+#ifdef HALF_SIZE
+    const ivec2 last = textureSize(uColor, 0) - 1;
+    const ivec2 a = 2 * texel, b = min(a + 1, last);
+    const vec4 p0 = pixel(a), p1 = pixel(ivec2(b.x, a.y)), p2 = pixel(ivec2(a.x, b.y)), p3 = pixel(b);
+    const float c01 = abs(p0.a) <= abs(p1.a) ? p0.a : p1.a;
+    const float c23 = abs(p2.a) <= abs(p3.a) ? p2.a : p3.a;
+    const float sharpest = abs(c01) <= abs(c23) ? c01 : c23;
+    outColor = vec4(0.25 * (p0.rgb + p1.rgb + p2.rgb + p3.rgb), 0.5 * sharpest);
+#else
+    outColor = pixel(texel);
+#endif
 }

@@ -11,7 +11,7 @@ layout(std140, binding = 0) uniform ViewParams {
     int mode;        // 0 colour, 1 depth (red channel), 2 signed CoC (alpha channel)
     float rangeLow;  // depth: nearest metres on the scale; CoC: unused
     float rangeHigh; // depth: farthest metres; CoC: max CoC in pixels
-    float pad;
+    int sourceShift; // 1: the source is half the target's size (Resolution::Half), else 0
 };
 
 // Five-key ramp from dark violet (near) through teal and green to yellow (far), in sRGB.
@@ -26,7 +26,7 @@ vec3 depthRamp(float t)
 
 void main()
 {
-    const vec4 source = texelFetch(uSource, ivec2(gl_FragCoord.xy), 0);
+    const vec4 source = texelFetch(uSource, ivec2(gl_FragCoord.xy) >> sourceShift, 0);
     if (mode == 0) {
         outColor = vec4(source.rgb, 1.0);
     } else if (mode == 1) {

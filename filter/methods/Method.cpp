@@ -16,11 +16,6 @@
 
 namespace defocus {
 
-std::string_view resolutionName(Resolution resolution)
-{
-    return resolution == Resolution::Full ? "full" : "half";
-}
-
 std::string_view precisionName(TargetFormat format)
 {
     return format == TargetFormat::Rgba16F ? "16F" : "32F";
@@ -109,7 +104,7 @@ MethodResult Method::run(const Frame& frame, const LensSettings& lens, const Met
     assert(settings.samples >= info().minSamples && settings.samples <= info().maxSamples);
     const auto start = std::chrono::steady_clock::now();
     MethodResult result;
-    if (settings.resolution == Resolution::Full) {
+    if (settings.resolution == Resolution::Full || scalesItself()) {
         result = process(frame, lens, settings);
     } else {
         CV_Assert(frame.color.type() == CV_8UC3 || frame.color.type() == CV_32FC3);

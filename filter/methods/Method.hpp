@@ -19,26 +19,22 @@
 
 namespace defocus {
 
-enum class Resolution {
-    Full, ///< the method runs at the frame's size
-    Half  ///< downscaled by 2, run, upscaled (see MethodSettings::resolution)
-};
-
 struct MethodSettings {
     /// Taps per pass. McIntosh: [2, 64] per directional pass. Fixed by the kernel for riguer (12),
     /// lazy8 (8) and gaussian5x5 (25), and ignored by the references; MethodInfo::samples lists
     /// what each accepts.
     int samples = 16;
-    /// Full, or half: colour is made linear, sanitised and area-averaged to half size
-    /// ((w + 1) / 2 x (h + 1) / 2), depth is resized by nearest neighbour (no depth invented at
-    /// edges), the method runs with max-coc halved (CoC in pixels halves with the width), and its
-    /// output is upscaled bilinearly. Scaling runs on the CPU and counts in the wall time.
+    /// Full, or half. The pipeline methods (mcintosh, rhombi) blur at half size themselves
+    /// (QualitySettings::resolution: the output keeps the frame's in-focus pixels). For the
+    /// others, Method::run() scales on the CPU, in the wall time: colour made linear, sanitised
+    /// and area-averaged to (w + 1) / 2 x (h + 1) / 2, depth resized by nearest neighbour (no
+    /// depth invented at edges), max-coc halved (CoC in pixels halves with the width), and the
+    /// output upscaled bilinearly.
     Resolution resolution = Resolution::Full;
     /// Precision of the intermediate and output render targets of GPU methods.
     TargetFormat precision = TargetFormat::Rgba16F;
 };
 
-std::string_view resolutionName(Resolution resolution); ///< "full", "half"
 std::string_view precisionName(TargetFormat format);    ///< "16F", "32F"
 
 struct MethodInfo {
@@ -70,7 +66,10 @@ public:
     MethodResult run(const Frame& frame, const LensSettings& lens, const MethodSettings& settings);
 
 protected:
-    /// Runs at the frame's own size; run() adds the half-resolution wrapper and the wall time.
+    /// true: process() runs at settings.resolution itself, and run() adds no CPU scaling.
+    virtual bool scalesItself() const { return false; }
+    /// Runs at the frame's own size (or at settings.resolution, when scalesItself()); run()
+    /// adds the half-resolution wrapper and the wall time.
     virtual MethodResult process(const Frame& frame, const LensSettings& lens, const MethodSettings& settings) = 0;
 };
 

@@ -26,6 +26,7 @@ QualitySettings PipelineMethod::quality(std::string_view name, const MethodSetti
     quality.nearField = name.ends_with("-near");
     quality.samples = settings.samples;
     quality.targetFormat = settings.precision;
+    quality.resolution = settings.resolution;
     quality.adaptive = true;
     return quality;
 }

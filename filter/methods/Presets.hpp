@@ -24,9 +24,8 @@ struct Preset {
 const std::vector<Preset>& presets();
 /// The preset called `name`; throws std::invalid_argument naming the choices for another name.
 const Preset& preset(std::string_view name);
-/// The QualitySettings of preset `name` for defocus::Pipeline (samples and precision). A preset
-/// at half resolution needs the method wrapper's downscale (Method::run) as well; check
-/// preset(name).settings.resolution. Throws std::invalid_argument for an unknown name.
+/// The QualitySettings of preset `name` for defocus::Pipeline (kernel, near field, samples,
+/// resolution, precision). Throws std::invalid_argument for an unknown name.
 QualitySettings presetSettings(std::string_view name);
 
 inline constexpr std::string_view kDefaultPreset = "balanced";

@@ -10,6 +10,7 @@ namespace defocus {
 
 CocPass::CocPass()
     : program_("fullscreen.vert", "coc.frag", kName),
+      halfProgram_("fullscreen.vert", "coc.frag", "coc half size", {"HALF_SIZE 1"}),
       uniforms_(sizeof(Uniforms), "coc params"),
       nearest_(GL_NEAREST, "coc nearest")
 {
@@ -29,19 +30,24 @@ float CocPass::largestColor(bool halfTarget)
     return halfTarget ? kLargestHalf : kLargestFloat;
 }
 
-void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-                  const gl::Framebuffer& target, float highlightGain)
+CocPass::Uniforms CocPass::uniforms(const CocCoefficients& k, bool halfTarget, float highlightGain)
 {
-    const Uniforms u{{k.nearScale, k.nearOffset, k.farScale, k.farOffset},
-                     k.focusM,
-                     k.maxCocPx,
-                     k.inverseDepth ? 1 : 0,
-                     largestColor(halfTarget),
-                     highlightGain};
+    return {{k.nearScale, k.nearOffset, k.farScale, k.farOffset},
+            k.focusM,
+            k.maxCocPx,
+            k.inverseDepth ? 1 : 0,
+            largestColor(halfTarget),
+            highlightGain};
+}
+
+void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
+                  const gl::Framebuffer& target, float highlightGain, bool halfSize)
+{
+    const Uniforms u = uniforms(k, halfTarget, highlightGain);
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();
-    program_.use();
+    (halfSize ? halfProgram_ : program_).use();
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
     drawFullscreenTriangle();

@@ -1,4 +1,5 @@
-// Pass 1: linear colour + signed CoC (pixels) in alpha, into a float target. Shader: coc.frag.
+// Pass 1: linear colour + signed CoC (pixels) in alpha, into a float target of the frame's size
+// or half of it. Shader: coc.frag.
 #pragma once
 
 #include "filter/Lens.hpp"
@@ -16,11 +17,12 @@ public:
     /// `color`: sRGB8 or float RGB; `depth`: R32F metres with no holes; `halfTarget` keeps HDR
     /// colour below the half-float maximum.
     /// `highlightGain` > 1 scales near-clipped pixels of 8-bit input that get blurred (coc.frag).
+    /// `halfSize`: the target is ((w + 1) / 2, (h + 1) / 2) and each texel averages 2x2 pixels,
+    /// its CoC in half-size pixels.
     void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-             const gl::Framebuffer& target, float highlightGain = 1.0f);
+             const gl::Framebuffer& target, float highlightGain = 1.0f, bool halfSize = false);
 
-private:
-    /// Mirrors the std140 block CocParams in coc.frag.
+    /// Mirrors the std140 block CocParams in coc_params.glsl (shared with upscale.frag).
     struct Uniforms {
         float coefficients[4];
         float focusM;
@@ -29,7 +31,10 @@ private:
         float largestColor;
         float highlightGain;
     };
-    gl::Program program_;
+    static Uniforms uniforms(const CocCoefficients& k, bool halfTarget, float highlightGain);
+
+private:
+    gl::Program program_, halfProgram_;
     gl::UniformBuffer uniforms_;
     gl::Sampler nearest_;
 };

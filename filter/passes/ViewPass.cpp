@@ -14,7 +14,9 @@ ViewPass::ViewPass()
 
 void ViewPass::run(const gl::Texture& source, Mode mode, float low, float high, const gl::Framebuffer& target)
 {
-    const Uniforms u{static_cast<int>(mode), low, high, 0.0f};
+    // A half-size target (Resolution::Half) is shown at the frame's size, each texel as 2x2.
+    const int shift = source.width() < target.width() ? 1 : 0;
+    const Uniforms u{static_cast<int>(mode), low, high, shift};
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();

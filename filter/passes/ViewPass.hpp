@@ -21,7 +21,7 @@ private:
         int mode;
         float rangeLow;
         float rangeHigh;
-        float pad;
+        int sourceShift; ///< log2 of target size / source size: 0, or 1 for a half-size source
     };
     gl::Program program_;
     gl::UniformBuffer uniforms_;

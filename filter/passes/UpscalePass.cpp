@@ -1,0 +1,71 @@
+// Upscale pass: the CoC pass's lens parameters (the shader recomputes each pixel's CoC from the
+// frame's depth) and a draw over the frame-sized target.
+#include "filter/passes/UpscalePass.hpp"
+
+#include <string>
+
+#include <fmt/format.h>
+
+#include "filter/SceneAnalysis.hpp"
+
+#include "filter/passes/CocPass.hpp"
+#include "filter/passes/Pass.hpp"
+
+namespace defocus {
+
+namespace {
+
+std::vector<std::string> defines(bool interpolateOnly)
+{
+    std::vector<std::string> list{fmt::format("DETAIL_BELOW_PX {:.6f}", kUpscaleDetailBelowPx)};
+    if (interpolateOnly)
+        list.emplace_back("INTERPOLATE_ONLY 1");
+    return list;
+}
+
+} // namespace
+
+UpscalePass::UpscalePass()
+    : program_("fullscreen.vert", "upscale.frag", kName, defines(false)),
+      detailTiles_("tiles.vert", "upscale.frag", "upscale detail tiles", defines(false)),
+      interpolateOnly_("fullscreen.vert", "upscale.frag", "upscale interpolate", defines(true)),
+      prefilter_("fullscreen.vert", "upscale_prefilter.frag", "upscale prefilter"),
+      uniforms_(sizeof(CocPass::Uniforms), "upscale params"),
+      nearest_(GL_NEAREST, "upscale nearest"),
+      linear_(GL_LINEAR, "upscale linear")
+{
+}
+
+void UpscalePass::prefilter(const Io& io)
+{
+    io.prefiltered.bindForDraw();
+    prefilter_.use();
+    bindTexture(0, io.blurred.id(), linear_.id());
+    bindTexture(1, io.halfInput.id(), nearest_.id());
+    drawFullscreenTriangle();
+}
+
+void UpscalePass::upscale(const Io& io, const CocCoefficients& k, bool halfTarget, const TileList* detailTiles)
+{
+    const CocPass::Uniforms u = CocPass::uniforms(k, halfTarget, 1.0f);
+    uniforms_.update(&u, sizeof u);
+    uniforms_.bind(0);
+    io.target.bindForDraw();
+    bindTexture(0, io.color.id(), nearest_.id());
+    bindTexture(1, io.depth.id(), nearest_.id());
+    bindTexture(2, io.sharpened.id(), linear_.id());
+    bindTexture(3, io.added.id(), linear_.id());
+    if (!detailTiles) {
+        program_.use();
+        drawFullscreenTriangle();
+        return;
+    }
+    interpolateOnly_.use();
+    drawFullscreenTriangle();
+    if (detailTiles->count() > 0) {
+        detailTiles_.use();
+        detailTiles->draw();
+    }
+}
+
+} // namespace defocus
