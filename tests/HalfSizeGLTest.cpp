@@ -54,6 +54,48 @@ TEST_F(HalfSize, OutputHasTheFrameSizeAndEveryViewToo)
     EXPECT_EQ(pipeline.readTarget(View::Input).size(), cv::Size(49, 31));
 }
 
+TEST_F(HalfSize, InputIsTheMeanOfEachBlockWithItsSharpestCoc)
+{
+    // 8-bit input: the mean is of linear light (sRGB decoded before the filtering). Both the
+    // gather variant and the per-pixel one (with highlight recovery, which has no clipped
+    // pixels to scale here: noise below 250) must give it: to 2e-3 against the exact curve on
+    // the CPU (llvmpipe's sRGB decode measured 1.2e-3 off it, a third of an 8-bit step at the
+    // top of the range), and to float rounding against each other.
+    Frame frame = textured({64, 48}, 0);
+    cv::min(frame.color, cv::Scalar::all(240), frame.color);
+    frame.depth.colRange(0, 32).setTo(1.0f); // a depth edge inside no block: columns 31 | 32
+    frame.depth.at<float>(10, 41) = 1.0f;     // one sharp pixel in a blurred block
+    const LensSettings lens = test::lensWithFarCoc(12.0);
+    cv::Mat expected;
+    cv::resize(decodeSrgb(frame.color), expected, {32, 24}, 0, 0, cv::INTER_AREA);
+    cv::Mat first;
+    for (const double gain : {1.0, 4.0}) {
+        QualitySettings q = quality(Resolution::Half);
+        q.highlightGain = gain;
+        Pipeline pipeline;
+        pipeline.process(frame, lens, q);
+        const cv::Mat input = pipeline.readTarget(View::Input);
+        cv::Mat rgba[4];
+        cv::split(input, rgba);
+        const cv::Mat channels[3] = {rgba[2], rgba[1], rgba[0]}; // the frame's BGR order
+        cv::Mat bgr;
+        cv::merge(channels, 3, bgr);
+        double worst = 0.0;
+        const cv::Mat error = cv::abs(bgr - expected);
+        cv::minMaxLoc(error.reshape(1), nullptr, &worst);
+        EXPECT_LT(worst, 2e-3) << "gain " << gain;
+        if (first.empty())
+            first = bgr;
+        else
+            EXPECT_LT(cv::norm(bgr, first, cv::NORM_INF), 1e-6);
+        // CoC in half-size pixels: 0 left of the edge, 12 / 2 right of it, and 0 for the block
+        // that holds the one sharp pixel.
+        EXPECT_FLOAT_EQ(rgba[3].at<float>(3, 3), 0.0f);
+        EXPECT_FLOAT_EQ(rgba[3].at<float>(3, 25), 6.0f);
+        EXPECT_FLOAT_EQ(rgba[3].at<float>(5, 20), 0.0f);
+    }
+}
+
 TEST_F(HalfSize, InFocusPixelsComeOutAsTheyWentIn)
 {
     const Frame frame = textured({96, 64}, 48);

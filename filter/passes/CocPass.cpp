@@ -11,8 +11,10 @@ namespace defocus {
 CocPass::CocPass()
     : program_("fullscreen.vert", "coc.frag", kName),
       halfProgram_("fullscreen.vert", "coc.frag", "coc half size", {"HALF_SIZE 1"}),
+      halfHighlightsProgram_("fullscreen.vert", "coc.frag", "coc half size highlights", {"HALF_SIZE 1", "HIGHLIGHTS 1"}),
       uniforms_(sizeof(Uniforms), "coc params"),
-      nearest_(GL_NEAREST, "coc nearest")
+      nearest_(GL_NEAREST, "coc nearest"),
+      linear_(GL_LINEAR, "coc linear")
 {
 }
 
@@ -47,9 +49,10 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocC
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();
-    (halfSize ? halfProgram_ : program_).use();
+    (!halfSize ? program_ : highlightGain > 1.0f ? halfHighlightsProgram_ : halfProgram_).use();
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
+    bindTexture(2, color.id(), linear_.id());
     drawFullscreenTriangle();
 }
 

@@ -34,9 +34,10 @@ public:
     static Uniforms uniforms(const CocCoefficients& k, bool halfTarget, float highlightGain);
 
 private:
-    gl::Program program_, halfProgram_;
+    gl::Program program_, halfProgram_, halfHighlightsProgram_;
     gl::UniformBuffer uniforms_;
     gl::Sampler nearest_;
+    gl::Sampler linear_;
 };
 
 } // namespace defocus
