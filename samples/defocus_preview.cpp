@@ -55,8 +55,9 @@ struct Options {
     std::string model = "thin-lens";
     std::optional<double> nearM;
     std::optional<double> farM;
-    /// The balanced preset (full resolution, which a live loop needs).
+    /// The balanced preset (half size: the fastest setting over 33 dB, docs/accuracy.md).
     QualitySettings quality = presetSettings(kDefaultPreset);
+    std::string resolution = std::string(resolutionName(quality.resolution));
     std::string view = "composite";
     AutofocusSettings autofocus;
     std::optional<std::size_t> frames;
@@ -351,6 +352,9 @@ int main(int argc, char** argv)
                    "the focus in proportion [default: half the focus]");
     app.add_option("--far", o.farM, "focal-range model: far limit, likewise [default: 3 x the focus]");
     app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64")->capture_default_str();
+    app.add_option("--resolution", o.resolution, "Size the blurs run at: full or half (the output keeps the frame's)")
+        ->check(CLI::IsMember({"full", "half"}))
+        ->capture_default_str();
     app.add_option("--highlight-gain", o.quality.highlightGain,
                    "Scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
         ->capture_default_str();
@@ -391,6 +395,7 @@ int main(int argc, char** argv)
     spdlog::set_level(o.verbose ? spdlog::level::debug : o.quiet ? spdlog::level::warn : spdlog::level::info);
 
     try {
+        parseResolution(o.resolution, o.quality.resolution);
         bool autoFocus = false;
         if (!parseFocus(o.focus, o.lens, autoFocus)) {
             spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);

@@ -57,9 +57,10 @@ TEST_F(Accuracy, BalancedPresetIsCloserToTheLensThanBlendersDefocusNode)
                 psnr, mcintosh, unblurred);
     // The claim of docs/accuracy.md: the default preset is closer to the path-traced lens than
     // Blender's compositor Defocus node at its best (32.9 dB, quoted by the scene's README).
-    // Measured 33.91 dB on llvmpipe; other drivers' rounding moves such figures by a few
-    // hundredths of a dB.
+    // Measured 33.10 dB on llvmpipe (half size; 33.91 dB at full size); other drivers' rounding
+    // moves such figures by a few hundredths of a dB, so it also holds issue 4's 33 dB.
     EXPECT_GT(psnr, 32.9);
+    EXPECT_GT(psnr, 33.0);
     // And the published chain stays where it was measured (30.27 dB), 3.6 dB under it: 2 dB of
     // margin between the two, so a regression of either kernel shows.
     EXPECT_GT(mcintosh, unblurred + 8.0);
