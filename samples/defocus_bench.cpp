@@ -31,6 +31,7 @@
 #include "sources/FrameSource.hpp"
 #include "filter/methods/Presets.hpp"
 #include "samples/BenchMachine.hpp"
+#include "samples/BenchPlan.hpp"
 #include "samples/BenchTiming.hpp"
 
 #include <unistd.h>
@@ -543,6 +544,31 @@ int timingMain(int argc, char** argv)
     }
 }
 
+/// `defocus-bench plan ...`: the plan against every pass on every pixel (samples/BenchPlan.hpp).
+int planMain(int argc, char** argv)
+{
+    defocus::PlanOptions o;
+    CLI::App app{"defocus-bench plan: ms per frame with the per-frame plan and with every pass on every pixel, "
+                 "and how far apart their outputs are, on the TUM clip (f/2, f/22) and the synthetic clips"};
+    app.add_option("--data", o.data, "TUM RGB-D folder")->capture_default_str();
+    app.add_option("--quality", o.preset, "Preset: fast, balanced or high")
+        ->check(CLI::IsMember({"fast", "balanced", "high"}))
+        ->capture_default_str();
+    app.add_option("--passes", o.passes, "Timed passes over each clip per mode")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000));
+    app.add_option("--synthetic-frames", o.syntheticFrames, "Frames of each synthetic clip")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 10000));
+    CLI11_PARSE(app, argc, argv);
+    try {
+        return defocus::runPlanComparison(o);
+    } catch (const std::exception& error) {
+        std::fprintf(stderr, "defocus-bench plan: %s\n", error.what());
+        return 2;
+    }
+}
+
 /// `defocus-bench accuracy ...` runs the accuracy sweep, built as its own program beside this one.
 int accuracyMain(int argc, char** argv, const char* self)
 {
@@ -562,6 +588,8 @@ int main(int argc, char** argv)
 {
     if (argc > 1 && std::string_view(argv[1]) == "timing")
         return timingMain(argc - 1, argv + 1);
+    if (argc > 1 && std::string_view(argv[1]) == "plan")
+        return planMain(argc - 1, argv + 1);
     if (argc > 1 && std::string_view(argv[1]) == "accuracy")
         return accuracyMain(argc - 1, argv + 1, argv[0]);
     Options o;
