@@ -328,9 +328,9 @@ int main(int argc, char** argv)
     app.add_option("--far", o.lens.farLimitM, "focal-range model: metres where far blur reaches --max-coc")
         ->capture_default_str();
     app.add_option("--quality", o.qualityPreset,
-                   "Preset from the accuracy benchmark (docs/accuracy.md): fast (rhombi with near field, 6 taps, at "
-                   "half size), balanced (6 taps), high (12 taps); --samples, --precision, --resolution, --hexagon "
-                   "and --near-field override it")
+                   "Preset from the accuracy benchmark (docs/accuracy.md), all rhombi with their near field: fast (4 "
+                   "taps, half size), balanced (6 taps, half size), high (12 taps, full size); --samples, "
+                   "--precision, --resolution, --hexagon and --near-field override it")
         ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
     app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
@@ -344,8 +344,8 @@ int main(int argc, char** argv)
     app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
         ->check(CLI::IsMember({"16f", "32f"}));
     app.add_option("--resolution", o.resolution,
-                   "Size the blurs run at: full, or half (a quarter of the cost; the output keeps the frame's size "
-                   "and its in-focus pixels) [default: from --quality]")
+                   "Size the blurs run at: full, or half (a quarter of the pixels; the output keeps the frame's "
+                   "size and its in-focus pixels) [default: from --quality]")
         ->check(CLI::IsMember({"full", "half"}));
     std::vector<std::string> views;
     for (const View v : kAllViews)
