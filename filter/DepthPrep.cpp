@@ -11,28 +11,37 @@ namespace defocus {
 
 namespace {
 
+void pushPull(cv::Mat& value, cv::Mat& weight);
+
+// Push: the half-size level of `weighted` (value * weight) and `weight`, whose ratio is the
+// weighted mean of each 2x2 block, with its own holes filled (recursively); returned upsampled
+// to the frame's size for the pull.
+cv::Mat coarseLevel(const cv::Mat& weighted, const cv::Mat& weight)
+{
+    const cv::Size half((weighted.cols + 1) / 2, (weighted.rows + 1) / 2);
+    cv::Mat coarseWeighted, coarseWeight, coarseValue;
+    cv::resize(weighted, coarseWeighted, half, 0, 0, cv::INTER_AREA);
+    cv::resize(weight, coarseWeight, half, 0, 0, cv::INTER_AREA);
+    cv::divide(coarseWeighted, cv::max(coarseWeight, 1e-12), coarseValue);
+    // A coarse pixel is fully trusted once its block held one full sample's worth of weight.
+    coarseWeight = cv::min(coarseWeight * 4.0, 1.0);
+    if (cv::countNonZero(coarseWeight < 1.0f) > 0)
+        pushPull(coarseValue, coarseWeight);
+    cv::Mat up;
+    cv::resize(coarseValue, up, weighted.size(), 0, 0, cv::INTER_LINEAR);
+    return up;
+}
+
 // Fills pixels with weight < 1 in `value` from a half-resolution pyramid level, recursively.
 // `value` holds weighted averages where weight > 0; weight is in [0, 1].
 void pushPull(cv::Mat& value, cv::Mat& weight)
 {
     if (value.rows <= 1 && value.cols <= 1)
         return;
-    const cv::Size half((value.cols + 1) / 2, (value.rows + 1) / 2);
-    // Push: area-average value*weight and weight; their ratio is the weighted mean of each block.
-    cv::Mat weighted = value.mul(weight);
-    cv::Mat coarseWeighted, coarseWeight;
-    cv::resize(weighted, coarseWeighted, half, 0, 0, cv::INTER_AREA);
-    cv::resize(weight, coarseWeight, half, 0, 0, cv::INTER_AREA);
-    cv::Mat coarseValue;
-    cv::divide(coarseWeighted, cv::max(coarseWeight, 1e-12), coarseValue);
-    // A coarse pixel is fully trusted once its block held one full sample's worth of weight.
-    coarseWeight = cv::min(coarseWeight * 4.0, 1.0);
-    if (cv::countNonZero(coarseWeight < 1.0f) > 0)
-        pushPull(coarseValue, coarseWeight);
+    const cv::Mat weighted = value.mul(weight);
     // Pull: blend the upsampled coarse level into the holes.
-    cv::Mat up;
-    cv::resize(coarseValue, up, value.size(), 0, 0, cv::INTER_LINEAR);
-    cv::Mat inverse = 1.0 - weight;
+    const cv::Mat up = coarseLevel(weighted, weight);
+    const cv::Mat inverse = 1.0 - weight;
     value = weighted + up.mul(inverse);
     weight = cv::Mat::ones(value.size(), CV_32F);
 }
@@ -44,17 +53,7 @@ void pushPull(cv::Mat& value, cv::Mat& weight)
 /// one process).
 void fillHoles(cv::Mat& value, const cv::Mat& weight, const cv::Mat& holes)
 {
-    const cv::Size half((value.cols + 1) / 2, (value.rows + 1) / 2);
-    cv::Mat coarseWeighted, coarseWeight, coarseValue;
-    cv::resize(value, coarseWeighted, half, 0, 0, cv::INTER_AREA);
-    cv::resize(weight, coarseWeight, half, 0, 0, cv::INTER_AREA);
-    cv::divide(coarseWeighted, cv::max(coarseWeight, 1e-12), coarseValue);
-    coarseWeight = cv::min(coarseWeight * 4.0, 1.0);
-    if (cv::countNonZero(coarseWeight < 1.0f) > 0)
-        pushPull(coarseValue, coarseWeight);
-    cv::Mat up;
-    cv::resize(coarseValue, up, value.size(), 0, 0, cv::INTER_LINEAR);
-    up.copyTo(value, holes);
+    coarseLevel(value, weight).copyTo(value, holes);
 }
 
 } // namespace
