@@ -12,6 +12,18 @@ namespace defocus {
 
 namespace {
 
+/// Sets `value` to the one of `values` whose name (`nameOf`) is `name`; false when none is.
+template <typename Enum, typename Values, typename NameOf>
+bool parseName(std::string_view name, const Values& values, NameOf nameOf, Enum& value)
+{
+    for (const Enum candidate : values)
+        if (nameOf(candidate) == name) {
+            value = candidate;
+            return true;
+        }
+    return false;
+}
+
 constexpr std::string_view kViewNames[] = {"input", "horizontal", "diagonal-a", "diagonal-b",
                                            "composite", "depth", "coc"};
 
@@ -35,13 +47,7 @@ std::string_view viewName(View view)
 
 bool parseView(std::string_view name, View& view)
 {
-    for (const View candidate : kAllViews) {
-        if (viewName(candidate) == name) {
-            view = candidate;
-            return true;
-        }
-    }
-    return false;
+    return parseName(name, kAllViews, viewName, view);
 }
 
 std::vector<SettingIssue> validate(LensSettings& lens, bool clamp)
@@ -99,12 +105,8 @@ std::string_view resolutionName(Resolution resolution)
 
 bool parseResolution(std::string_view name, Resolution& resolution)
 {
-    for (const Resolution r : {Resolution::Full, Resolution::Half})
-        if (name == resolutionName(r)) {
-            resolution = r;
-            return true;
-        }
-    return false;
+    constexpr Resolution kAll[] = {Resolution::Full, Resolution::Half};
+    return parseName(name, kAll, resolutionName, resolution);
 }
 
 std::string_view kernelName(HexagonKernel kernel)
@@ -114,12 +116,8 @@ std::string_view kernelName(HexagonKernel kernel)
 
 bool parseKernel(std::string_view name, HexagonKernel& kernel)
 {
-    for (const HexagonKernel k : {HexagonKernel::McIntoshMin, HexagonKernel::RhombiSum})
-        if (name == kernelName(k)) {
-            kernel = k;
-            return true;
-        }
-    return false;
+    constexpr HexagonKernel kAll[] = {HexagonKernel::McIntoshMin, HexagonKernel::RhombiSum};
+    return parseName(name, kAll, kernelName, kernel);
 }
 
 bool parseFocus(std::string_view text, LensSettings& lens, bool& isAuto)
