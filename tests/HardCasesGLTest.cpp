@@ -817,6 +817,38 @@ TEST_P(HardCases, FiniteInRangeInFocusKeptAndContinuous)
     }
 }
 
+// The same cases with the blurs at half size (Resolution::Half, the balanced preset's): one
+// render each. The output has the frame's size and is finite and non-negative. It is not
+// bounded by the input's range as the full-size passes are: the upscale's prefilter
+// (upscale_prefilter.frag) is 2R - B(R), which may overshoot an edge by up to the local range,
+// so the bound is twice the input's largest value.
+TEST_P(HardCases, HalfSizeFiniteNonNegativeAndFrameSized)
+{
+    const HardCase& c = GetParam();
+    LensSettings lens = baseLens();
+    QualitySettings quality;
+    if (c.setup)
+        c.setup(lens, quality);
+    validate(lens, true);
+    validate(quality, true);
+    quality.resolution = Resolution::Half;
+    const Frame frame{makeColor(c.color, c.size), makeDepth(c.depth, c.depthValue, c.size), 0.0, 0, c.name};
+    const Reference ref = makeReference(frame.color, quality.targetFormat);
+    Pipeline pipeline(false);
+    const cv::Mat linear = pipeline.run(frame, lens, quality, View::Composite, Encoding::Linear32F);
+    ASSERT_EQ(linear.size(), c.size);
+    ASSERT_TRUE(test::allFinite(linear));
+    double lo = 0.0, hi = 0.0;
+    cv::minMaxLoc(linear.reshape(1), &lo, &hi);
+    EXPECT_GE(lo, 0.0);
+    const double largest = std::max({ref.hi[0], ref.hi[1], ref.hi[2]});
+    EXPECT_LE(hi, 2.0 * largest * (1.0 + relativeTolerance(quality.targetFormat)) + kAbsoluteTolerance);
+    EXPECT_EQ(pipeline.read(View::Composite, Encoding::Srgb8).size(), c.size);
+    const cv::Mat input = pipeline.readTarget(View::Input);
+    EXPECT_EQ(input.size(), cv::Size((c.size.width + 1) / 2, (c.size.height + 1) / 2));
+    EXPECT_TRUE(test::allFinite(input));
+}
+
 INSTANTIATE_TEST_SUITE_P(Issue3, HardCases, ::testing::ValuesIn(kCases),
                          [](const ::testing::TestParamInfo<HardCase>& p) { return std::string(p.param.name); });
 
