@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "filter/Pipeline.hpp"
+#include "filter/methods/Presets.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/GpuTimer.hpp"
 #include "filter/passes/CalibrationPass.hpp"
@@ -51,7 +52,7 @@ int runTimingComparison(const TimingOptions& options)
     LensSettings lens;
     lens.focusM = 1.0;
     lens.fNumber = 1.4;
-    QualitySettings quality;
+    const QualitySettings quality = presetSettings(options.preset);
 
     // The calibration pass blurs the frame's colour into a target of its own, timed with its own
     // queries, interleaved with the pipeline's frames.
@@ -83,10 +84,12 @@ int runTimingComparison(const TimingOptions& options)
     nlohmann::json result{{"renderer", context.info().glRenderer},
                           {"width", size.width},
                           {"height", size.height},
+                          {"preset", options.preset},
                           {"calibration_ms", calibrationMedian},
                           {"passes", nlohmann::json::object()}};
-    std::printf("defocus-bench timing on %s, %dx%d, %d runs; calibration pass %.2f ms\n",
-                context.info().glRenderer.c_str(), size.width, size.height, options.runs, calibrationMedian);
+    std::printf("defocus-bench timing on %s, %dx%d, --quality %s, %d runs; calibration pass %.2f ms\n",
+                context.info().glRenderer.c_str(), size.width, size.height, options.preset.c_str(), options.runs,
+                calibrationMedian);
     for (const auto& [name, v] : passMs)
         result["passes"][name] = {{"ms", median(v)}, {"ratio", median(v) / calibrationMedian}};
 
@@ -110,6 +113,9 @@ int runTimingComparison(const TimingOptions& options)
                      error.what());
         return 2;
     }
+    if (baseline.value("preset", std::string("(none)")) != options.preset)
+        std::printf("note: the baseline timed --quality %s, this run --quality %s\n",
+                    baseline.value("preset", std::string("(not recorded)")).c_str(), options.preset.c_str());
     int regressions = 0;
     std::printf("  %-12s %8s %8s %8s  (ratio = pass / calibration; limit %.2fx the baseline)\n", "pass", "ratio",
                 "baseline", "change", options.maxRatio);

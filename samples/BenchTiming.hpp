@@ -13,6 +13,7 @@ struct TimingOptions {
     std::string data = "data/tum_fr1_rpy"; ///< TUM folder to take frames from
     std::string baseline;                  ///< compare with this file
     std::string writeBaseline;             ///< write the measured ratios here
+    std::string preset = "balanced";       ///< the quality preset timed (filter/methods/Presets.hpp)
     int runs = 15;                         ///< measured frames (medians over them)
     double maxRatio = 3.0;                 ///< fail when a pass's ratio grows more than this
 };

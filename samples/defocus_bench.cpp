@@ -531,6 +531,9 @@ int timingMain(int argc, char** argv)
     app.add_option("--data", o.data, "TUM RGB-D folder to take frames from")->capture_default_str();
     app.add_option("--baseline", o.baseline, "Compare with this baseline JSON; exit 1 on a regression");
     app.add_option("--write-baseline", o.writeBaseline, "Write the measured ratios to this JSON file");
+    app.add_option("--quality", o.preset, "Preset whose passes are timed: fast, balanced or high")
+        ->check(CLI::IsMember({"fast", "balanced", "high"}))
+        ->capture_default_str();
     app.add_option("--runs", o.runs, "Measured frames")->capture_default_str()->check(CLI::Range(3, 10000));
     app.add_option("--max-ratio", o.maxRatio, "Largest allowed growth of a pass's ratio over the baseline")
         ->capture_default_str()
