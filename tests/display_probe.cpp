@@ -253,8 +253,10 @@ TEST_F(DisplayXvfb, PreviewShowsTheProcessedFrameAndReactsToKeysAndClicks)
         last = std::move(*frame);
     ASSERT_EQ(last.color.size(), cv::Size(640, 480));
 
-    Preview preview({env("DEFOCUS_PREVIEW"), options.input.string(), "--trace", "--tau", "0.05", "--screenshot-dir",
-                     scratch.string()},
+    // Full size: the balanced preset blurs at half size, where view 1 (the blur's input) is the
+    // half-size target shown 2x2 per texel; at full size it is the frame itself, as checked below.
+    Preview preview({env("DEFOCUS_PREVIEW"), options.input.string(), "--trace", "--tau", "0.05", "--resolution", "full",
+                     "--screenshot-dir", scratch.string()},
                     (scratch / "preview.log").string());
     const std::regex ended(R"(shown frame=9 new=0 view=composite .*ended=1)");
     ASSERT_TRUE(preview.waitFor(ended, 45s)) << preview.log();
