@@ -139,9 +139,10 @@ TEST_F(HalfSize, BlurMatchesTheFullSizeBlur)
 TEST_F(HalfSize, FlatColourStaysFlatAndLightKeepsItsEnergy)
 {
     // Far and blurred: a flat grey with one bright point (float input, HDR). The prefilter
-    // passes flat areas unchanged and the blur, the prefilter and the interpolation each keep
-    // the sum of light (measured: within 0.03 % of the point's energy; 1 % allowed, for the
-    // borders' clamp and other drivers' filtering).
+    // passes flat areas unchanged, and the blur and the interpolation keep the sum of light;
+    // the prefilter's clamp to its neighbourhood (no dark ring round a light) cuts its
+    // undershoot, which adds a little: measured +1.8 % of the point's energy here (+1.9 % and
+    // +1.6 % on black at 15 and 31 px). 3 % allowed; unclamped it was 0.03 %.
     cv::Mat color(64, 64, CV_32FC3, cv::Scalar::all(0.25f));
     color.at<cv::Vec3f>(32, 32) = cv::Vec3f(200.0f, 200.0f, 200.0f);
     const Frame frame{color, cv::Mat(64, 64, CV_32F, cv::Scalar(2.0f)), 0.0, 0, "point"};
@@ -149,7 +150,7 @@ TEST_F(HalfSize, FlatColourStaysFlatAndLightKeepsItsEnergy)
     const cv::Mat out =
         pipeline.run(frame, test::lensWithFarCoc(12.0), quality(Resolution::Half), View::Composite, Encoding::Linear32F);
     const cv::Scalar in = cv::sum(color), result = cv::sum(out);
-    EXPECT_NEAR(result[1], in[1], 0.01 * (200.0 - 0.25));
+    EXPECT_NEAR(result[1], in[1], 0.03 * (200.0 - 0.25));
     // A corner far from the point: the grey, to float precision.
     const cv::Vec3f corner = out.at<cv::Vec3f>(4, 4);
     EXPECT_NEAR(corner[1], 0.25f, 1e-5f);

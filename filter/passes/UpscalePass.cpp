@@ -40,7 +40,7 @@ void UpscalePass::prefilter(const Io& io)
 {
     io.prefiltered.bindForDraw();
     prefilter_.use();
-    bindTexture(0, io.blurred.id(), linear_.id());
+    bindTexture(0, io.blurred.id(), nearest_.id());
     bindTexture(1, io.halfInput.id(), nearest_.id());
     drawFullscreenTriangle();
 }
