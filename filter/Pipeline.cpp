@@ -167,6 +167,16 @@ struct Pipeline::Impl {
     int tileSize() const { return SceneAnalysis::kTileSize >> blurShift; }
     /// Half size: the blurred result into `blurred`, then upscaled with the frame into `out`.
     void upscale(const gl::Framebuffer& out);
+    /// The composite of A and B (and the McIntosh near layer) into `target`, unfused.
+    void composite(const gl::Framebuffer& target)
+    {
+        const bool near = plan.nearField;
+        if (quality.kernel == HexagonKernel::RhombiSum)
+            compositePass.runSum(diagonalA.texture, diagonalB.texture, target);
+        else
+            compositePass.run(diagonalA.texture, diagonalB.texture, target, near ? &nearA.texture : nullptr,
+                              near ? &nearB.texture : nullptr);
+    }
 
     explicit Impl(bool timers) : timer(timers) {}
 
@@ -376,12 +386,7 @@ void Pipeline::Impl::upscale(const gl::Framebuffer& out)
         rhombiSecondPass(&blurred.framebuffer);
     } else {
         timer.begin(CompositePass::kName);
-        const bool near = plan.nearField;
-        if (quality.kernel == HexagonKernel::RhombiSum)
-            compositePass.runSum(diagonalA.texture, diagonalB.texture, blurred.framebuffer);
-        else
-            compositePass.run(diagonalA.texture, diagonalB.texture, blurred.framebuffer,
-                              near ? &nearA.texture : nullptr, near ? &nearB.texture : nullptr);
+        composite(blurred.framebuffer);
         timer.end();
     }
     sharpened.ensure(coc.texture.format(), blurSize, "half-size result, sharpened");
@@ -484,12 +489,7 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
             p.rhombiSecondPass(&out.framebuffer);
     } else if (view == View::Composite) {
         p.timer.begin(CompositePass::kName);
-        const bool near = p.plan.nearField;
-        if (p.quality.kernel == HexagonKernel::RhombiSum)
-            p.compositePass.runSum(p.diagonalA.texture, p.diagonalB.texture, out.framebuffer);
-        else
-            p.compositePass.run(p.diagonalA.texture, p.diagonalB.texture, out.framebuffer,
-                                near ? &p.nearA.texture : nullptr, near ? &p.nearB.texture : nullptr);
+        p.composite(out.framebuffer);
     } else {
         if (view == View::DiagonalA || view == View::DiagonalB)
             p.ensureDiagonals();
