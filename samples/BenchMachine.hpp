@@ -1,7 +1,9 @@
-// What the benchmark programs record about the run: when, and on which CPU.
+// What the benchmark programs share: when and on which CPU a run was made, and the statistics
+// they report (median and p90 with linear interpolation between order statistics).
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace defocus {
 
@@ -9,5 +11,11 @@ namespace defocus {
 std::string utcNow();
 /// The CPU's model name from /proc/cpuinfo; "unknown" when it cannot be read.
 std::string cpuModel();
+
+/// q-quantile with linear interpolation between order statistics (numpy's default); NaN when
+/// `values` is empty.
+double quantile(std::vector<double> values, double q);
+double median(const std::vector<double>& values); ///< quantile(values, 0.5)
+double p90(const std::vector<double>& values);    ///< quantile(values, 0.9)
 
 } // namespace defocus

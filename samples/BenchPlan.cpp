@@ -15,6 +15,7 @@
 #include "filter/Pipeline.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/methods/Presets.hpp"
+#include "samples/BenchMachine.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/SyntheticSource.hpp"
 
@@ -27,12 +28,6 @@ struct Clip {
     std::vector<Frame> frames;
     std::vector<LensSettings> lenses; ///< one per frame
 };
-
-double median(std::vector<double> v)
-{
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
-}
 
 Clip tumClip(const std::string& folder, double fNumber)
 {

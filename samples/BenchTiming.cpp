@@ -13,22 +13,13 @@
 
 #include "filter/Pipeline.hpp"
 #include "filter/methods/Presets.hpp"
+#include "samples/BenchMachine.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/GpuTimer.hpp"
 #include "filter/passes/CalibrationPass.hpp"
 #include "sources/FrameSource.hpp"
 
 namespace defocus {
-
-namespace {
-
-double median(std::vector<double> v)
-{
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
-}
-
-} // namespace
 
 int runTimingComparison(const TimingOptions& options)
 {

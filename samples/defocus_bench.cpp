@@ -91,29 +91,6 @@ struct CocSpread {
     double p90AbsPx = 0.0;
 };
 
-/// q-quantile with linear interpolation between order statistics (numpy's default).
-double quantile(std::vector<double> values, double q)
-{
-    if (values.empty())
-        return std::nan("");
-    std::sort(values.begin(), values.end());
-    const double position = q * static_cast<double>(values.size() - 1);
-    const auto below = static_cast<std::size_t>(std::floor(position));
-    const std::size_t above = std::min(below + 1, values.size() - 1);
-    const double t = position - static_cast<double>(below);
-    return values[below] + (values[above] - values[below]) * t;
-}
-
-double median(const std::vector<double>& values)
-{
-    return quantile(values, 0.5);
-}
-
-double p90(const std::vector<double>& values)
-{
-    return quantile(values, 0.9);
-}
-
 cv::Size parseSize(const std::string& text)
 {
     int width = 0, height = 0;

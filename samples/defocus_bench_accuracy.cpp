@@ -92,15 +92,6 @@ struct Row {
     cv::Mat output; ///< kept for the contact sheet (linear)
 };
 
-double median(std::vector<double> values)
-{
-    if (values.empty())
-        return std::nan("");
-    std::sort(values.begin(), values.end());
-    const std::size_t n = values.size();
-    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
 double loadAverage()
 {
     std::ifstream file("/proc/loadavg");
