@@ -12,11 +12,11 @@
 #include <nlohmann/json.hpp>
 
 #include "filter/Pipeline.hpp"
-#include "filter/methods/Presets.hpp"
-#include "samples/BenchMachine.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/GpuTimer.hpp"
+#include "filter/methods/Presets.hpp"
 #include "filter/passes/CalibrationPass.hpp"
+#include "samples/BenchMachine.hpp"
 #include "sources/FrameSource.hpp"
 
 namespace defocus {
@@ -104,9 +104,9 @@ int runTimingComparison(const TimingOptions& options)
                      error.what());
         return 2;
     }
-    if (baseline.value("preset", std::string("(none)")) != options.preset)
-        std::printf("note: the baseline timed --quality %s, this run --quality %s\n",
-                    baseline.value("preset", std::string("(not recorded)")).c_str(), options.preset.c_str());
+    if (const auto timed = baseline.value("preset", std::string("(not recorded)")); timed != options.preset)
+        std::printf("note: the baseline timed --quality %s, this run --quality %s\n", timed.c_str(),
+                    options.preset.c_str());
     int regressions = 0;
     std::printf("  %-12s %8s %8s %8s  (ratio = pass / calibration; limit %.2fx the baseline)\n", "pass", "ratio",
                 "baseline", "change", options.maxRatio);
