@@ -30,7 +30,9 @@ void main()
     // Half-size texel i covers the frame's pixels 2i and 2i + 1, so its centre lies at 2i + 1:
     // in the half-size texture's coordinates the pixel's centre is at half of its own.
     const vec2 uv = gl_FragCoord.xy * 0.5 / vec2(textureSize(uSharpened, 0));
-    const vec3 interpolated = max(textureLod(uSharpened, uv, 0.0).rgb, vec3(0.0));
+    // S lies within its neighbourhood's range of the (non-negative) blur: so does its
+    // interpolation.
+    const vec3 interpolated = textureLod(uSharpened, uv, 0.0).rgb;
 #ifdef INTERPOLATE_ONLY
     outColor = vec4(interpolated, 1.0);
 #else
