@@ -56,6 +56,7 @@ struct Options {
     std::vector<std::string> methods; ///< empty: all
     bool noReference = false;
     bool noTimers = false;
+    bool saveOutputs = false; ///< write every setting's linear result to --out/outputs/*.exr
     std::string replot; ///< accuracy.json of an earlier run: draw its Pareto plot only
     double bladeRotationDeg = 0.0; ///< the GPU methods' hexagon; 0 = a corner on top, as the truth
     std::string scene = "blender"; ///< or "synthetic[:NAME]": input and truth rendered (docs/synthetic.md)
@@ -714,6 +715,17 @@ int run(const Options& options, const std::string& commandLine)
             throw std::runtime_error(fmt::format("cannot write {}", (out / "accuracy.json").string()));
     }
 
+    if (options.saveOutputs) {
+        // One EXR per setting, named like the CSV's rows ("rhombi-near 12 full 32F.exr"), for
+        // error maps and crops of one's own.
+        fs::create_directories(out / "outputs");
+        for (const Row& row : rows) {
+            const fs::path file = out / "outputs" / (row.label + ".exr");
+            if (!cv::imwrite(file.string(), row.output))
+                throw std::runtime_error(fmt::format("cannot write {}", file.string()));
+        }
+    }
+
     if (!cv::imwrite((out / "pareto.png").string(), paretoPlot(rows, unblurred.psnrLinear),
                      {cv::IMWRITE_PNG_COMPRESSION, 9}))
         throw std::runtime_error("cannot write pareto.png");
@@ -778,6 +790,8 @@ int main(int argc, char** argv)
         ->check(CLI::Range(-180.0, 180.0))
         ->capture_default_str();
     app.add_flag("--no-timers", options.noTimers, "no GL timer queries");
+    app.add_flag("--save-outputs", options.saveOutputs,
+                 "also write every setting's result, linear float, to --out/outputs/LABEL.exr");
     app.add_option("--replot", options.replot, "only redraw --out/pareto.png from an earlier run's accuracy.json");
     std::vector<std::string> scenes{"blender", "synthetic"};
     for (const std::string& name : syntheticSceneNames())
