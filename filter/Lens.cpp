@@ -15,18 +15,26 @@ CocCoefficients cocCoefficients(const LensSettings& lens, int imageWidthPx)
 
     if (lens.model == CocModel::ThinLens) {
         // With f the focal length, N the f-number, A = f / N the aperture diameter, S1 the focus
-        // distance and S2 = z the depth (all in metres), the signed CoC on the sensor is
+        // distance and S2 = z the depth (all in metres), a point at z blurs into a disc of
+        // diameter A |z - S1| / z on the focus plane (similar triangles through the aperture),
+        // which the sensor at distance d behind the lens sees d / S1 times as large:
+        //   c = A (z - S1) / z * d / S1
+        // With the sensor at the image distance d = v = f S1 / (S1 - f), this is the textbook
         //   c = A (z - S1) / z * f / (S1 - f)
         //     = A f / (S1 - f)  -  A f S1 / (S1 - f) * (1 / z)
         // so c = K0 * (1/z) + K1 with K1 = A f / (S1 - f) and K0 = -K1 * S1, times pixels per
-        // metre of sensor. As S1 -> inf, K1 -> 0 and K0 -> -A f: everything is in front of focus.
+        // metre of sensor; with the field of view from the focal length (d = f), K1 = A f / S1.
+        // As S1 -> inf, K1 -> 0 and K0 -> -A f in both: everything is in front of focus.
         const double f = lens.focalLengthMm * 1e-3;
         const double aperture = f / lens.fNumber;
         double k0 = 0.0, k1 = 0.0;
         if (std::isinf(lens.focusM)) {
             k0 = -aperture * f;
         } else {
-            k1 = aperture * f / (lens.focusM - f);
+            const double sensorDistanceOverFocus = lens.fieldOfView == FieldOfView::ImageDistance
+                                                       ? f / (lens.focusM - f)
+                                                       : f / lens.focusM;
+            k1 = aperture * sensorDistanceOverFocus;
             k0 = -k1 * lens.focusM;
         }
         k.nearScale = k.farScale = static_cast<float>(k0 * pixelsPerMetreOnSensor);
@@ -60,7 +68,8 @@ double thinLensCocPixels(const LensSettings& lens, int imageWidthPx, double dept
     const double A = f / lens.fNumber;
     const double S1 = lens.focusM;
     const double S2 = depthM;
-    const double c = A * std::abs(S2 - S1) / S2 * f / (S1 - f);
+    const double sensorDistance = lens.fieldOfView == FieldOfView::ImageDistance ? f * S1 / (S1 - f) : f;
+    const double c = A * std::abs(S2 - S1) / S2 * sensorDistance / S1;
     const double signedC = S2 < S1 ? -c : c;
     return signedC * imageWidthPx / (lens.sensorWidthMm * 1e-3);
 }

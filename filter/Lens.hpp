@@ -35,7 +35,8 @@ inline float cocPixels(const CocCoefficients& k, float depthM)
 }
 
 /// The thin-lens CoC in pixels before clamping, straight from the textbook formula
-/// c = A |S2 - S1| / S2 * f / (S1 - f), signed; a reference for the derived coefficients.
+/// c = A |S2 - S1| / S2 * f / (S1 - f) (with the field of view from the focal length,
+/// c = A |S2 - S1| / S2 * f / S1), signed; a reference for the derived coefficients.
 double thinLensCocPixels(const LensSettings& lens, int imageWidthPx, double depthM);
 
 } // namespace defocus

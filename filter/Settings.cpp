@@ -98,6 +98,17 @@ std::vector<SettingIssue> validate(QualitySettings& quality, bool clamp)
     return issues;
 }
 
+std::string_view fieldOfViewName(FieldOfView fov)
+{
+    return fov == FieldOfView::ImageDistance ? "image-distance" : "focal-length";
+}
+
+bool parseFieldOfView(std::string_view name, FieldOfView& fov)
+{
+    constexpr FieldOfView kAll[] = {FieldOfView::ImageDistance, FieldOfView::FocalLength};
+    return parseName(name, kAll, fieldOfViewName, fov);
+}
+
 std::string_view resolutionName(Resolution resolution)
 {
     return resolution == Resolution::Full ? "full" : "half";

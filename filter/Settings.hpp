@@ -16,6 +16,23 @@ enum class CocModel {
     FocalRange  ///< blur rising linearly from the focus distance to max-coc at a near and a far limit
 };
 
+/// Where the image's field of view comes from, with the thin-lens model. The filter does not
+/// reframe the picture; the two differ in how many of the image's pixels a blur on the sensor
+/// spans, by the factor (S - f) / S at focus distance S: 0.983 at 85 mm focused at 5 m, 0.90 at
+/// 0.85 m, the same at infinity.
+enum class FieldOfView {
+    /// A real camera: the sensor sits at the image distance v = f S / (S - f), so the field of
+    /// view narrows as the lens focuses closer ("focus breathing").
+    ImageDistance,
+    /// Renderers (Blender Cycles, and engines with a physical camera): the field of view is
+    /// 2 atan(sensor / 2f) whatever the focus, as if the sensor sat at the focal length.
+    FocalLength
+};
+
+std::string_view fieldOfViewName(FieldOfView fov); ///< "image-distance", "focal-length"
+/// Parses a name as printed by fieldOfViewName(); returns false when unknown.
+bool parseFieldOfView(std::string_view name, FieldOfView& fov);
+
 struct LensSettings {
     CocModel model = CocModel::ThinLens;
     /// Focal length, millimetres, [1, 1200].
@@ -26,6 +43,8 @@ struct LensSettings {
     double focusM = 2.0;
     /// Sensor width, millimetres, [1, 100]; the image width is fitted to it.
     double sensorWidthMm = 36.0;
+    /// Thin-lens model only: the distance behind the lens where the sensor width spans the image.
+    FieldOfView fieldOfView = FieldOfView::ImageDistance;
     /// Largest CoC diameter, pixels, [0, 512]; larger blur is clamped to it.
     double maxCocPx = 32.0;
     /// Rotation of the hexagonal aperture, degrees counter-clockwise as seen in the image,

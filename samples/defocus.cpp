@@ -55,6 +55,7 @@ struct Options {
     QualitySettings quality;
     std::string qualityPreset = std::string(kDefaultPreset);
     std::string model = "thin-lens";
+    std::string fov = "image-distance";
     std::string precision = "16f";
     std::string resolution = "full";
     std::string kernel = "rhombi";
@@ -318,6 +319,10 @@ int main(int argc, char** argv)
     app.add_option("--focal-length", o.lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
     app.add_option("--sensor-width", o.lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
         ->capture_default_str();
+    app.add_option("--fov-from", o.fov, "Where the sensor width spans the image: image-distance (a real "
+                   "camera, whose view narrows as it focuses closer) or focal-length (Blender, game engines)")
+        ->check(CLI::IsMember({"image-distance", "focal-length"}))
+        ->capture_default_str();
     app.add_option("--max-coc", o.lens.maxCocPx, "Largest blur diameter, pixels, 0..512")->capture_default_str();
     app.add_option("--coc-model", o.model,
                    "thin-lens (physical) or focal-range (blur rises linearly from --focus to max at --near/--far)")
@@ -410,6 +415,7 @@ int main(int argc, char** argv)
         }
         o.quality.adaptive = !alwaysOn;
         o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
+        parseFieldOfView(o.fov, o.lens.fieldOfView); // checked by CLI11
         o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
         parseKernel(o.kernel, o.quality.kernel);
         parseResolution(o.resolution, o.quality.resolution);

@@ -575,8 +575,10 @@ int run(const Options& options, const std::string& commandLine)
     fmt::print("defocus-bench-accuracy, {}\n", utcNow());
     fmt::print("GL renderer: {}; GL {}; EGL platform: {}\nCPU: {}, {} cores; load average {:.2f} before the runs\n",
                info.glRenderer, info.glVersion, info.platform, cpu, cores, loadBefore);
-    fmt::print("scene: {} {}x{}; lens 85 mm f/1.4 focused at 5 m, 36 mm sensor, max-coc 64 px\n", sceneLabel,
-               color.cols, color.rows);
+    fmt::print("scene: {} {}x{}; lens {} mm f/{} focused at {} m, {} mm sensor, field of view from the {}, "
+               "max-coc {} px\n",
+               sceneLabel, color.cols, color.rows, lens.focalLengthMm, lens.fNumber, lens.focusM, lens.sensorWidthMm,
+               lens.fieldOfView == FieldOfView::FocalLength ? "focal length" : "image distance", lens.maxCocPx);
     fmt::print("error: {}; PSNR of linear values clipped to [0,1] (and after sRGB "
                "encoding), SSIM on luma; regions in-focus {:.1f}%, out-of-focus {:.1f}%, depth-edge {:.1f}% "
                "(filter/Metrics.hpp)\n",
@@ -683,6 +685,7 @@ int run(const Options& options, const std::string& commandLine)
                                {"fNumber", lens.fNumber},
                                {"focusM", lens.focusM},
                                {"sensorWidthMm", lens.sensorWidthMm},
+                               {"fieldOfView", fieldOfViewName(lens.fieldOfView)},
                                {"maxCocPx", lens.maxCocPx}}}};
     json["timing"] = {{"runs", options.runs}, {"warmup", options.warmup}, {"statistic", "median"}};
     json["unblurred"] = errorJson(unblurred);

@@ -53,6 +53,7 @@ struct Options {
     std::string focus = "auto";
     LensSettings lens;
     std::string model = "thin-lens";
+    std::string fov = "image-distance";
     std::optional<double> nearM;
     std::optional<double> farM;
     /// The balanced preset (half size: the fastest setting over 33 dB, docs/accuracy.md).
@@ -99,6 +100,7 @@ int run(const Options& o)
     LiveControls controls;
     controls.lens = o.lens;
     controls.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
+    parseFieldOfView(o.fov, controls.lens.fieldOfView); // checked by CLI11
     parseView(o.view, controls.view); // checked by CLI11
     controls.autofocus = o.focus == "auto";
     Autofocus autofocus(o.autofocus);
@@ -342,6 +344,10 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--focal-length", o.lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
     app.add_option("--sensor-width", o.lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
+        ->capture_default_str();
+    app.add_option("--fov-from", o.fov, "Where the sensor width spans the image: image-distance (a real "
+                   "camera, whose view narrows as it focuses closer) or focal-length (Blender, game engines)")
+        ->check(CLI::IsMember({"image-distance", "focal-length"}))
         ->capture_default_str();
     app.add_option("--max-coc", o.lens.maxCocPx, "Largest blur diameter, pixels, 0..512 ([ ] keys)")->capture_default_str();
     app.add_option("--coc-model", o.model, "thin-lens or focal-range (m key)")

@@ -39,6 +39,7 @@ int main(int argc, char** argv)
     std::string out = "out/synthetic";
     std::size_t frame = 0;
     std::string focus = "pull";
+    std::string fov = "image-distance";
     SyntheticSettings settings;
     int runs = 1;
     bool noReference = false;
@@ -52,6 +53,10 @@ int main(int argc, char** argv)
     app.add_option("--focal-length", settings.lens.focalLengthMm, "Focal length, millimetres")->capture_default_str();
     app.add_option("--f-number", settings.lens.fNumber, "f-number")->capture_default_str();
     app.add_option("--sensor-width", settings.lens.sensorWidthMm, "Sensor width, millimetres")->capture_default_str();
+    app.add_option("--fov-from", fov, "Where the sensor width spans the image: image-distance (a real "
+                   "camera, whose view narrows as it focuses closer) or focal-length (Blender, game engines)")
+        ->check(CLI::IsMember({"image-distance", "focal-length"}))
+        ->capture_default_str();
     app.add_option("--focus", focus, "Focus distance, metres, or 'pull' for the scene's focus pull")
         ->capture_default_str();
     app.add_option("--samples", settings.aperture.samples, "Lens positions the reference averages")
@@ -65,6 +70,7 @@ int main(int argc, char** argv)
     app.add_option("--runs", runs, "Render the reference this many times and print each time")->check(CLI::Range(1, 100));
     app.add_flag("--no-reference", noReference, "Only the pinhole colour and the depth");
     CLI11_PARSE(app, argc, argv);
+    parseFieldOfView(fov, settings.lens.fieldOfView); // checked by CLI11
 
     if (focus != "pull") {
         try {

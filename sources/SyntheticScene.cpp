@@ -490,7 +490,10 @@ struct SyntheticScene::State {
         const double f = lens.focalLengthMm * 1e-3;
         const double inverseFocus = std::isinf(lens.focusM) ? 0.0 : 1.0 / lens.focusM;
         const double imageDistance = f / (1.0 - f * inverseFocus); // v = f S1 / (S1 - f)
-        const double tanX = lens.sensorWidthMm * 1e-3 / (2.0 * imageDistance);
+        // A renderer's camera (FieldOfView::FocalLength) keeps the sensor at f: the blur is
+        // then A |1/S1 - 1/z| f / sensor * width px, as filter/Lens.cpp has it for that case.
+        const double sensorDistance = lens.fieldOfView == FieldOfView::ImageDistance ? imageDistance : f;
+        const double tanX = lens.sensorWidthMm * 1e-3 / (2.0 * sensorDistance);
         const double tanY = tanX * settings.height / settings.width;
         // x_clip = q.x / tanX + shift * d with d = -q.z, so the q.z coefficient is -shift.
         const double shiftX = lensOffsetM.x * inverseFocus / tanX + 2.0 * jitterPx.x / settings.width;

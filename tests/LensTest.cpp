@@ -12,11 +12,13 @@ namespace defocus {
 namespace {
 
 // The Blender scene of data/blender_spheres: 85 mm, f/1.4, focus 5 m, 36 mm over 640 px.
-/// The Blender scene's camera with max-coc at its limit, so that no figure below is clamped.
+/// The Blender scene's camera with max-coc at its limit, so that no figure below is clamped,
+/// and the sensor at the image distance, as the scene's documented figures have it.
 LensSettings blenderLens()
 {
     LensSettings lens = blenderSpheresLens();
     lens.maxCocPx = 512.0;
+    lens.fieldOfView = FieldOfView::ImageDistance;
     return lens;
 }
 
@@ -51,6 +53,27 @@ TEST(Lens, MaddEqualsTextbookFormula)
         // float32 evaluation: relative 1e-5 of the two terms (~1000 px at 0.2 m).
         EXPECT_NEAR(cocPixels(k, static_cast<float>(z)), std::clamp(expected, -512.0, 512.0), 2e-2) << "z=" << z;
     }
+}
+
+TEST(Lens, FieldOfViewFromTheFocalLengthScalesTheCocBySMinusFOverS)
+{
+    // A renderer's camera (the sensor width fitted at f, not at v = f S / (S - f)) sees the
+    // same blur on the focus plane at f / v = (S - f) / S of the pixels: 0.983 at 85 mm
+    // focused at 5 m, what docs/synthetic.md measured on the Cycles truth (0.980).
+    LensSettings image = blenderLens();
+    LensSettings focal = image;
+    focal.fieldOfView = FieldOfView::FocalLength;
+    const auto ki = cocCoefficients(image, 640), kf = cocCoefficients(focal, 640);
+    const double scale = (5.0 - 0.085) / 5.0;
+    for (const float z : {1.43f, 3.0f, 8.0f, 30.0f}) {
+        // Relative 1e-5 of float32 over the two cancelling terms.
+        EXPECT_NEAR(cocPixels(kf, z), scale * cocPixels(ki, z), 2e-3) << "z=" << z;
+        EXPECT_NEAR(cocPixels(kf, z), thinLensCocPixels(focal, 640, z), 2e-2) << "z=" << z;
+    }
+    EXPECT_NEAR(cocPixels(kf, 5.0f), 0.0f, 1e-3f);
+    // At infinity the sensor sits at f either way: no difference.
+    image.focusM = focal.focusM = std::numeric_limits<double>::infinity();
+    EXPECT_FLOAT_EQ(cocPixels(cocCoefficients(focal, 640), 10.0f), cocPixels(cocCoefficients(image, 640), 10.0f));
 }
 
 TEST(Lens, ClampsToMaxCoc)

@@ -113,7 +113,8 @@ TEST(Metrics, RegionMasksPartitionTheImage)
 
 TEST(Metrics, CocMapFollowsTheLensModel)
 {
-    const LensSettings lens = blenderSpheresLens();
+    LensSettings lens = blenderSpheresLens();
+    lens.fieldOfView = FieldOfView::ImageDistance; // the documented figures use the lens formula
     const CocCoefficients k = cocCoefficients(lens, 640);
     cv::Mat depth(1, 3, CV_32FC1);
     depth.at<float>(0, 0) = 1.43f;

@@ -450,21 +450,28 @@ TEST_F(SyntheticSceneGL, TheCyclesTruthAgreesOnCocSizeAndOrientation)
     SyntheticScene scene(pointScene(25.0, radiusForPixels(s, 25.0, 5.0)), s);
     const Bokeh ours = measureBokeh(scene.render(0).reference, {319.5, 23.5}, coc, 6, false);
 
-    // Cycles derives the field of view from the focal length, the thin lens from the image
-    // distance v = f S1 / (S1 - f): the same blur on the sensor is (S1 - f) / S1 = 0.983 times
-    // as many of Cycles' pixels (docs/synthetic.md).
-    const double cyclesScale = (lens.focusM - 0.085) / lens.focusM;
-    std::printf("[ FIGURE   ] CoC at 25 m: thin lens %.2f px; Cycles truth %.3f x (%zu highlights; expected %.3f); "
-                "synthetic %.3f x; corner %.1f deg from straight up in Cycles, %.1f in ours\n",
-                coc, meanRatio, ratios.size(), cyclesScale, ours.areaDiameter / coc, meanOffset,
+    // Cycles derives the field of view from the focal length, and so does this lens
+    // (FieldOfView::FocalLength, for the filter and for the synthetic camera): the CoC is
+    // (S1 - f) / S1 = 0.983 of the lens formula's with the sensor at the image distance v.
+    LensSettings atImageDistance = lens;
+    atImageDistance.fieldOfView = FieldOfView::ImageDistance;
+    const double lensFormula = thinLensCocPixels(atImageDistance, 640, 25.0);
+    std::printf("[ FIGURE   ] CoC at 25 m: %.2f px with the field of view from f (%.2f px from v); Cycles truth "
+                "%.3f x (%zu highlights); synthetic %.3f x; corner %.1f deg from straight up in Cycles, %.1f in "
+                "ours\n",
+                coc, lensFormula, meanRatio, ratios.size(), ours.areaDiameter / coc, meanOffset,
                 angleDistance(ours.cornerDeg, 90.0, 60.0));
+    EXPECT_NEAR(coc / lensFormula, (lens.focusM - 0.085) / lens.focusM, 1e-6);
     // Sizes: the Cycles highlights scatter by +-1.5% (5 px lights on a brick texture,
-    // path-tracing noise); the mean of six is good to about 1%.
-    EXPECT_NEAR(meanRatio, cyclesScale, 0.015);
+    // path-tracing noise); the mean of six is good to about 1% (measured 0.996; 0.980 of the
+    // lens formula's CoC with the sensor at v).
+    EXPECT_NEAR(meanRatio, 1.0, 0.015);
     EXPECT_NEAR(ours.areaDiameter / coc, 1.0, 0.03);
-    // Orientation: a corner up in both (a flat top would be 30 degrees off).
+    // Orientation: a corner up in both (a flat top would be 30 degrees off). Ours is exactly up
+    // by construction; the estimator reads 3.0 to 5.1 degrees on this 15 px bokeh as its size
+    // moves by a quarter pixel between the two camera conventions, so 7.5 leaves it room.
     EXPECT_LT(meanOffset, 10.0);
-    EXPECT_LT(angleDistance(ours.cornerDeg, 90.0, 60.0), 5.0);
+    EXPECT_LT(angleDistance(ours.cornerDeg, 90.0, 60.0), 7.5);
 }
 
 TEST_F(SyntheticSceneGL, DemoBlursASyntheticClipWithNoInput)

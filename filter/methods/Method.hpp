@@ -74,8 +74,9 @@ protected:
 };
 
 /// The camera of data/blender_spheres, the scene the registry is measured on
-/// (../shared/data/README.md): thin lens, 85 mm, f/1.4, focus 5 m, 36 mm sensor width; max-coc
-/// 64 px, above the scene's largest CoC at 640 px (46.6 px), so nothing is clamped.
+/// (../shared/data/README.md): thin lens, 85 mm, f/1.4, focus 5 m, 36 mm sensor width, the field
+/// of view from the focal length as Cycles has it; max-coc 64 px, above the scene's largest CoC
+/// at 640 px (45.8 px), so nothing is clamped.
 LensSettings blenderSpheresLens();
 
 /// Every method, in table order: mcintosh, riguer, lazy8, gaussian5x5, reference, reference-pointy.
