@@ -193,6 +193,27 @@ TEST_F(Passes, RhombusKernelFollowsTheBladeRotation)
     EXPECT_NEAR(s.height, std::sqrt(3.0) / 2.0 * 40.0, 3.0);
 }
 
+// The frame's edge: taps beyond it read the image mirrored (the scene goes on much as it does
+// inside), not the edge pixels repeated, which gave a bright edge column the weight of all that
+// lies beyond the frame.
+TEST_F(Passes, RhombusTapsBeyondTheEdgeReadTheFrameMirrored)
+{
+    cv::Mat color(64, 64, CV_32FC3, cv::Scalar::all(0.0f));
+    color.col(0).setTo(cv::Scalar::all(1.0f)); // a bright edge column
+    const cv::Mat far(color.size(), CV_32F, cv::Scalar(2.0f));
+    Pipeline pipeline;
+    const cv::Mat out = pipeline.run({color, far, 0.0, 0, "edge"}, test::lensWithFarCoc(20.0), QualitySettings{},
+                                     View::Composite, Encoding::Linear32F);
+    // A hexagon 20 px across is about 17 px wide at the edge's row; mirrored, the column and its
+    // reflection are 2 of them, on the three rhombi's separable means roughly 2/17 = 0.12.
+    // Repeated, the edge fills the half beyond the frame: about 0.5.
+    const float edge = out.at<cv::Vec3f>(32, 0)[0];
+    EXPECT_GT(edge, 0.05f);
+    EXPECT_LT(edge, 0.25f);
+    // The light is kept, not lost beyond the edge: the mirrored mean over the frame's width.
+    EXPECT_NEAR(cv::mean(out.row(32))[0], 1.0 / 64.0, 0.5 / 64.0);
+}
+
 // Issue 6 section 4: a light clipped in 8-bit video blooms when --highlight-gain scales it up;
 // frames without clipped pixels, and pixels in focus, are untouched.
 TEST_F(Passes, HighlightRecoveryScalesClippedLightsThatGetBlurred)

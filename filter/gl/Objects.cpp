@@ -66,15 +66,15 @@ void Framebuffer::bindForDraw() const
     glViewport(0, 0, width_, height_);
 }
 
-Sampler::Sampler(GLenum filter, std::string_view name)
+Sampler::Sampler(GLenum filter, std::string_view name, GLenum wrap)
 {
     GLuint id = 0;
     glCreateSamplers(1, &id);
     handle_ = Handle<deleteSampler>(id);
     glSamplerParameteri(id, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(filter));
     glSamplerParameteri(id, GL_TEXTURE_MAG_FILTER, static_cast<GLint>(filter));
-    glSamplerParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glSamplerParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glSamplerParameteri(id, GL_TEXTURE_WRAP_S, static_cast<GLint>(wrap));
+    glSamplerParameteri(id, GL_TEXTURE_WRAP_T, static_cast<GLint>(wrap));
     label(GL_SAMPLER, id, name);
 }
 

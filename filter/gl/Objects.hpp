@@ -110,7 +110,9 @@ private:
 class Sampler {
 public:
     Sampler() = default;
-    Sampler(GLenum filter, std::string_view name);
+    /// `wrap` addresses coordinates outside the texture: GL_CLAMP_TO_EDGE repeats the edge
+    /// texels, GL_MIRRORED_REPEAT reflects the image about its edges.
+    Sampler(GLenum filter, std::string_view name, GLenum wrap = GL_CLAMP_TO_EDGE);
     GLuint id() const { return handle_.id(); }
 
 private:

@@ -59,10 +59,14 @@ std::array<RhombusBlurPass::LineMode, 4> RhombusBlurPass::lineModes(const Direct
     };
 }
 
+// Taps beyond the frame read it mirrored: where the edge pixels were repeated instead, a pixel
+// at the edge took a third to a half of its blur from them alone. On the Blender scene the 8 px
+// next to the edges measured 30.6 dB against the truth, clamped, and 32.6 dB mirrored (the rest
+// of the frame 34.8); the whole frame +0.22 dB at full size, +0.15 at half.
 RhombusBlurPass::RhombusBlurPass()
     : uniforms_(sizeof(Uniforms), "rhombus blur params"),
-      linear_(GL_LINEAR, "rhombus blur linear"),
-      nearest_(GL_NEAREST, "rhombus blur nearest")
+      linear_(GL_LINEAR, "rhombus blur linear", GL_MIRRORED_REPEAT),
+      nearest_(GL_NEAREST, "rhombus blur nearest", GL_MIRRORED_REPEAT)
 {
     // The variants of the default rotation (a corner on top), so that no frame pays for them.
     const auto modes = lineModes(directions(0.0f));
