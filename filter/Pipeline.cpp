@@ -19,6 +19,7 @@
 #include "filter/passes/CopyPass.hpp"
 #include "filter/passes/HexBlurPass.hpp"
 #include "filter/passes/RhombusBlurPass.hpp"
+#include "filter/passes/SceneAnalysisPass.hpp"
 #include "filter/passes/NearBlurPass.hpp"
 #include "filter/passes/UpscalePass.hpp"
 #include "filter/passes/ViewPass.hpp"
@@ -99,6 +100,7 @@ void validDepthRange(const cv::Mat& depth, float& lo, float& hi)
 struct Pipeline::Impl {
     gl::VertexArray vao = gl::VertexArray::create();
     CocPass cocPass;
+    SceneAnalysisPass sceneAnalysisPass;
     HexBlurPass hexBlurPass;
     RhombusBlurPass rhombusBlurPass;
     CompositePass compositePass;
@@ -262,7 +264,7 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
         }
     }
     p.prepareDepthAndPlan();
-    p.timings.analysisMs = msSince(start) - p.timings.depthPrepMs;
+    p.timings.analysisMs = msSince(start) - p.timings.depthPrepMs - p.timings.uploadMs;
     if (!(quality.adaptive && p.plan.allInFocus))
         p.render();
 }
@@ -270,11 +272,23 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
 void Pipeline::Impl::prepareDepthAndPlan()
 {
     // Depth: colour-sized, holes filled. With no depth at all, everything sits on the focus plane.
-    const auto start = Clock::now();
+    auto start = Clock::now();
     prepared = prepareDepth(depthInput, size, fallbackDepth);
     timings.depthPrepMs = msSince(start);
     depthPrepared = true;
-    analysis = analyseScene(prepared.metres, color, coefficients, prepared.invalidFraction);
+
+    start = Clock::now();
+    const bool srgbInput = color.type() == CV_8UC3;
+    ensureTexture(depth, GL_R32F, size, "filled depth");
+    ensureTexture(colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, size, "input colour");
+    CV_Assert(color.isContinuous() && prepared.metres.isContinuous());
+    colorTexture.upload(GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT, color.data);
+    depth.upload(GL_RED, GL_FLOAT, prepared.metres.data);
+    timings.uploadMs = msSince(start);
+
+    // The analysis on the GPU, where the frame now is; the plan waits for its few kilobytes.
+    analysis = finishAnalysis(sceneAnalysisPass.run(depth, colorTexture, srgbInput, coefficients), coefficients,
+                              prepared.invalidFraction);
     const bool allInFocus = plan.allInFocus && quality.adaptive;
     plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution);
     if (color.type() == CV_8UC3 && plan.highlights && !plan.allInFocus)
@@ -407,16 +421,7 @@ void Pipeline::Impl::render()
 {
     if (!depthPrepared)
         prepareDepthAndPlan();
-    auto start = Clock::now();
-    const bool srgbInput = color.type() == CV_8UC3;
-    ensureTexture(depth, GL_R32F, size, "filled depth");
-    ensureTexture(colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, size, "input colour");
-    CV_Assert(color.isContinuous() && prepared.metres.isContinuous());
-    colorTexture.upload(GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT, color.data);
-    depth.upload(GL_RED, GL_FLOAT, prepared.metres.data);
-    timings.uploadMs = msSince(start);
-
-    start = Clock::now();
+    const auto start = Clock::now();
     const bool half = quality.targetFormat == TargetFormat::Rgba16F;
     coc.ensure(half ? GL_RGBA16F : GL_RGBA32F, blurSize, "coc");
 

@@ -30,7 +30,7 @@ struct PassTime {
 /// queries (empty when the driver has none).
 struct FrameTimings {
     double depthPrepMs = 0.0; ///< resize + hole filling on the CPU
-    double analysisMs = 0.0;  ///< scene analysis + plan on the CPU
+    double analysisMs = 0.0;  ///< scene analysis (GPU, waited for) + plan (CPU)
     double uploadMs = 0.0;    ///< colour + depth to textures
     double renderMs = 0.0;    ///< submitting the passes
     double readbackMs = 0.0;  ///< output pass + glReadPixels (waits for the GPU)

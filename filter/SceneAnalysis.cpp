@@ -1,5 +1,5 @@
-// Scene analysis on the CPU, where the filled depth already is: the only place the "all in
-// focus" decision can be made before any upload or pass, which is what makes such a frame cheap.
+// Scene analysis: the CPU measurement (the GPU's reference, filter/passes/SceneAnalysisPass) and
+// what both share: the CoC ranges, the foreground's reach and the plan.
 #include "filter/SceneAnalysis.hpp"
 
 #include <algorithm>
@@ -23,33 +23,32 @@ bool SceneAnalysis::tileNeedsBlur(int x, int y, float sharpBelowPx) const
     return std::max(std::abs(tileMinCoc.at<float>(y, x)), std::abs(tileMaxCoc.at<float>(y, x))) >= sharpBelowPx;
 }
 
-SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k,
-                           double invalidDepthFraction)
+SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k)
 {
     CV_Assert(filledDepth.type() == CV_32FC1 && filledDepth.size() == color.size() &&
               (color.type() == CV_8UC3 || color.type() == CV_32FC3));
-    SceneAnalysis a;
+    SceneMeasurement m;
     constexpr int T = SceneAnalysis::kTileSize;
-    a.tiles = {(filledDepth.cols + T - 1) / T, (filledDepth.rows + T - 1) / T};
-    a.invalidDepthFraction = invalidDepthFraction;
+    m.tiles = {(filledDepth.cols + T - 1) / T, (filledDepth.rows + T - 1) / T};
+    m.pixels = filledDepth.total();
 
-    // CoC is monotonic in depth, so the tile's CoC range is the CoC of its depth range; only
-    // the histogram needs a CoC per pixel. Rows of tiles are independent: OpenCV's threads take
-    // them in bands (the GPU is idle while this runs), each band with its own histogram.
-    cv::Mat tileMinZ(a.tiles, CV_32F), tileMaxZ(a.tiles, CV_32F);
+    // Rows of tiles are independent: OpenCV's threads take them in bands, each band with its
+    // own histogram.
+    m.tileMinDepth.create(m.tiles, CV_32F);
+    m.tileMaxDepth.create(m.tiles, CV_32F);
     constexpr std::size_t kBins = SceneAnalysis::kHistogramEdges.size() + 1;
-    std::vector<std::array<int, kBins>> bandHistograms(static_cast<std::size_t>(a.tiles.height));
-    cv::parallel_for_(cv::Range(0, a.tiles.height), [&](const cv::Range& range) {
+    std::vector<std::array<int, kBins>> bandHistograms(static_cast<std::size_t>(m.tiles.height));
+    cv::parallel_for_(cv::Range(0, m.tiles.height), [&](const cv::Range& range) {
         for (int ty = range.start; ty < range.end; ++ty) {
-            float* lo = tileMinZ.ptr<float>(ty);
-            float* hi = tileMaxZ.ptr<float>(ty);
-            std::fill(lo, lo + a.tiles.width, std::numeric_limits<float>::max());
-            std::fill(hi, hi + a.tiles.width, std::numeric_limits<float>::lowest());
+            float* lo = m.tileMinDepth.ptr<float>(ty);
+            float* hi = m.tileMaxDepth.ptr<float>(ty);
+            std::fill(lo, lo + m.tiles.width, std::numeric_limits<float>::max());
+            std::fill(hi, hi + m.tiles.width, std::numeric_limits<float>::lowest());
             std::array<int, kBins>& histogram = bandHistograms[static_cast<std::size_t>(ty)];
             histogram.fill(0);
             for (int y = ty * T; y < std::min((ty + 1) * T, filledDepth.rows); ++y) {
                 const float* z = filledDepth.ptr<float>(y);
-                for (int tx = 0; tx < a.tiles.width; ++tx) {
+                for (int tx = 0; tx < m.tiles.width; ++tx) {
                     float tileLo = lo[tx], tileHi = hi[tx];
                     for (int x = tx * T; x < std::min((tx + 1) * T, filledDepth.cols); ++x) {
                         tileLo = std::min(tileLo, z[x]);
@@ -69,31 +68,7 @@ SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, con
     });
     for (const auto& band : bandHistograms)
         for (std::size_t bin = 0; bin < kBins; ++bin)
-            a.histogram[bin] += band[bin];
-    a.tileMinCoc.create(a.tiles, CV_32F);
-    a.tileMaxCoc.create(a.tiles, CV_32F);
-    a.minCoc = std::numeric_limits<float>::max();
-    a.maxCoc = std::numeric_limits<float>::lowest();
-    for (int ty = 0; ty < a.tiles.height; ++ty)
-        for (int tx = 0; tx < a.tiles.width; ++tx) {
-            const float lo = cocPixels(k, tileMinZ.at<float>(ty, tx));
-            const float hi = cocPixels(k, tileMaxZ.at<float>(ty, tx));
-            a.tileMinCoc.at<float>(ty, tx) = std::min(lo, hi);
-            a.tileMaxCoc.at<float>(ty, tx) = std::max(lo, hi);
-            a.minCoc = std::min(a.minCoc, std::min(lo, hi));
-            a.maxCoc = std::max(a.maxCoc, std::max(lo, hi));
-        }
-    a.foreground = a.minCoc <= -0.5f;
-
-    // Foreground reach: a near pixel of diameter d blurs pixels up to d/2 away. One extra tile
-    // covers the linear filtering of this map between tile centres.
-    a.tileNearDiameter = cv::max(-a.tileMinCoc, 0.0f);
-    a.tileNearDiameter.setTo(0.0f, a.tileNearDiameter < 0.5f);
-    if (a.foreground) {
-        const int reach = static_cast<int>(std::ceil(-a.minCoc / 2.0f / static_cast<float>(T))) + 1;
-        cv::dilate(a.tileNearDiameter, a.tileNearDiameter,
-                   cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
-    }
+            m.histogram[bin] += band[bin];
 
     // Highlights: 8-bit, any channel clipped (>= 250); float, luminance above 1. In bands too.
     std::vector<int> bandBright(static_cast<std::size_t>(color.rows), 0);
@@ -112,11 +87,51 @@ SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, con
             bandBright[static_cast<std::size_t>(y)] = count;
         }
     });
-    std::size_t bright = 0;
     for (const int count : bandBright)
-        bright += static_cast<std::size_t>(count);
-    a.highlightFraction = static_cast<double>(bright) / static_cast<double>(color.total());
+        m.highlightPixels += static_cast<std::size_t>(count);
+    return m;
+}
+
+SceneAnalysis finishAnalysis(const SceneMeasurement& m, const CocCoefficients& k, double invalidDepthFraction)
+{
+    CV_Assert(m.tileMinDepth.size() == m.tiles && m.tileMaxDepth.size() == m.tiles && m.pixels > 0);
+    constexpr int T = SceneAnalysis::kTileSize;
+    SceneAnalysis a;
+    a.tiles = m.tiles;
+    a.invalidDepthFraction = invalidDepthFraction;
+    a.histogram = m.histogram;
+    a.tileMinCoc.create(a.tiles, CV_32F);
+    a.tileMaxCoc.create(a.tiles, CV_32F);
+    a.minCoc = std::numeric_limits<float>::max();
+    a.maxCoc = std::numeric_limits<float>::lowest();
+    for (int ty = 0; ty < a.tiles.height; ++ty)
+        for (int tx = 0; tx < a.tiles.width; ++tx) {
+            const float lo = cocPixels(k, m.tileMinDepth.at<float>(ty, tx));
+            const float hi = cocPixels(k, m.tileMaxDepth.at<float>(ty, tx));
+            a.tileMinCoc.at<float>(ty, tx) = std::min(lo, hi);
+            a.tileMaxCoc.at<float>(ty, tx) = std::max(lo, hi);
+            a.minCoc = std::min(a.minCoc, std::min(lo, hi));
+            a.maxCoc = std::max(a.maxCoc, std::max(lo, hi));
+        }
+    a.foreground = a.minCoc <= -0.5f;
+
+    // Foreground reach: a near pixel of diameter d blurs pixels up to d/2 away. One extra tile
+    // covers the linear filtering of this map between tile centres.
+    a.tileNearDiameter = cv::max(-a.tileMinCoc, 0.0f);
+    a.tileNearDiameter.setTo(0.0f, a.tileNearDiameter < 0.5f);
+    if (a.foreground) {
+        const int reach = static_cast<int>(std::ceil(-a.minCoc / 2.0f / static_cast<float>(T))) + 1;
+        cv::dilate(a.tileNearDiameter, a.tileNearDiameter,
+                   cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
+    }
+    a.highlightFraction = static_cast<double>(m.highlightPixels) / static_cast<double>(m.pixels);
     return a;
+}
+
+SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k,
+                           double invalidDepthFraction)
+{
+    return finishAnalysis(measureScene(filledDepth, color, k), k, invalidDepthFraction);
 }
 
 FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel kernel, Resolution resolution)

@@ -1,5 +1,6 @@
-// What a frame calls for, measured before any GPU work: per-tile CoC range, a CoC histogram,
-// foreground blur, highlights and holes. The plan made from it decides which passes run where.
+// What a frame calls for: per-tile CoC range, a CoC histogram, foreground blur, highlights and
+// holes, measured on the GPU after the upload (the CPU version is the tests' reference). The
+// plan made from it decides which passes run where.
 #pragma once
 
 #include <array>
@@ -40,8 +41,28 @@ struct SceneAnalysis {
     bool tileNeedsBlur(int x, int y, float sharpBelowPx = 0.5f) const;
 };
 
-/// Analyses a frame from its filled depth (CV_32FC1 metres) and colour (8-bit: highlights are
-/// clipped pixels, >= 250 in any channel; float: luminance above 1).
+/// What a frame's pixels say before the lens turns depth ranges into CoC ranges: each tile's
+/// depth range, the |CoC| histogram and the count of highlight pixels. The pipeline measures it
+/// on the GPU (SceneAnalysisPass, scene_analysis.comp); measureScene() is the same on the CPU.
+struct SceneMeasurement {
+    cv::Size tiles;      ///< tile grid (ceil(width / 16) x ceil(height / 16))
+    cv::Mat tileMinDepth; ///< CV_32FC1 per tile, metres
+    cv::Mat tileMaxDepth;
+    std::array<int, SceneAnalysis::kHistogramEdges.size() + 1> histogram{}; ///< pixels per |CoC| bin
+    std::size_t highlightPixels = 0; ///< 8-bit: any channel >= 250; float: luminance above 1
+    std::size_t pixels = 0;
+};
+
+/// Measures a frame on the CPU from its filled depth (CV_32FC1 metres) and colour (CV_8UC3 or
+/// CV_32FC3 BGR).
+SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k);
+
+/// The analysis from a measurement: tile CoC ranges (CoC is monotonic in depth, so a tile's
+/// range is the CoC of its depth range), frame range, foreground and its reach.
+SceneAnalysis finishAnalysis(const SceneMeasurement& measurement, const CocCoefficients& k,
+                             double invalidDepthFraction);
+
+/// measureScene() then finishAnalysis(): the whole analysis on the CPU.
 SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k,
                            double invalidDepthFraction);
 

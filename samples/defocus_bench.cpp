@@ -289,7 +289,7 @@ SceneResult measure(Pipeline& pipeline, std::size_t& counter, const std::string&
     if (!gpuSum.empty())
         result.gpu.push_back({"sum", "GPU sum of passes", gpuSum});
     result.wall = {{"depthPrep", "depth prep (CPU)", depthPrep},
-                   {"analysis", "scene analysis (CPU)", analysis},
+                   {"analysis", "scene analysis (GPU)", analysis},
                    {"upload", "upload (wall)", upload},
                    {"renderSubmit", "render submit (wall)", render},
                    {"readback", "readback (wall)", readback},

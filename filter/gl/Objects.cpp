@@ -98,6 +98,26 @@ void UniformBuffer::bind(GLuint binding) const
     glBindBufferBase(GL_UNIFORM_BUFFER, binding, id());
 }
 
+StorageBuffer::StorageBuffer(GLsizeiptr size, std::string_view name) : size_(size)
+{
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    handle_ = Handle<deleteBuffer>(id);
+    glNamedBufferStorage(id, size, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    label(GL_BUFFER, id, name);
+}
+
+void StorageBuffer::bind(GLuint binding) const
+{
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, id());
+}
+
+void StorageBuffer::read(void* data, GLsizeiptr bytes) const
+{
+    assert(bytes <= size_);
+    glGetNamedBufferSubData(id(), 0, bytes, data);
+}
+
 VertexArray VertexArray::create()
 {
     GLuint id = 0;

@@ -133,6 +133,22 @@ private:
     GLsizeiptr size_ = 0;
 };
 
+/// A shader storage buffer of fixed size that compute shaders write and the CPU reads back.
+class StorageBuffer {
+public:
+    StorageBuffer() = default;
+    StorageBuffer(GLsizeiptr size, std::string_view name);
+    GLsizeiptr size() const { return size_; }
+    void bind(GLuint binding) const;
+    /// Copies `bytes` from the start into `data`; waits for the GPU's writes to finish.
+    void read(void* data, GLsizeiptr bytes) const;
+    GLuint id() const { return handle_.id(); }
+
+private:
+    Handle<deleteBuffer> handle_;
+    GLsizeiptr size_ = 0;
+};
+
 /// The empty vertex array that a full-screen triangle drawn from gl_VertexID needs in core GL.
 class VertexArray {
 public:

@@ -101,15 +101,27 @@ Program::Program(std::string_view vertexFile, std::string_view fragmentFile, std
         glDeleteShader(vertex);
         throw;
     }
+    link({vertex, fragment}, name);
+}
+
+Program Program::compute(std::string_view computeFile, std::string_view name, const std::vector<std::string>& defines)
+{
+    Program program;
+    program.link({compile(GL_COMPUTE_SHADER, computeFile, defines)}, name);
+    return program;
+}
+
+void Program::link(std::initializer_list<GLuint> shaders, std::string_view name)
+{
     const GLuint program = glCreateProgram();
     handle_ = Handle<deleteProgram>(program);
-    glAttachShader(program, vertex);
-    glAttachShader(program, fragment);
+    for (const GLuint shader : shaders)
+        glAttachShader(program, shader);
     glLinkProgram(program);
-    glDetachShader(program, vertex);
-    glDetachShader(program, fragment);
-    glDeleteShader(vertex);
-    glDeleteShader(fragment);
+    for (const GLuint shader : shaders) {
+        glDetachShader(program, shader);
+        glDeleteShader(shader);
+    }
     GLint ok = GL_FALSE;
     glGetProgramiv(program, GL_LINK_STATUS, &ok);
     if (ok != GL_TRUE)

@@ -2,6 +2,7 @@
 // the embedded set and variants chosen by a `#define` preamble.
 #pragma once
 
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -25,12 +26,19 @@ public:
     Program(std::string_view vertexFile, std::string_view fragmentFile, std::string_view name,
             const std::vector<std::string>& defines = {});
 
+    /// Builds the compute shader `computeFile` (a name in shaders/), as above.
+    static Program compute(std::string_view computeFile, std::string_view name,
+                           const std::vector<std::string>& defines = {});
+
     GLuint id() const { return handle_.id(); }
     void use() const { glUseProgram(id()); }
     /// Location of a uniform; -1 when the driver optimised it away.
     GLint uniform(const char* name) const { return glGetUniformLocation(id(), name); }
 
 private:
+    /// Links the compiled `shaders` (and deletes them), labelled `name`; throws ShaderError.
+    void link(std::initializer_list<GLuint> shaders, std::string_view name);
+
     Handle<deleteProgram> handle_;
 };
 
