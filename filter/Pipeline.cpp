@@ -116,7 +116,7 @@ struct Pipeline::Impl {
     gl::Texture colorTexture;
     gl::Texture depth;
     Target coc, horizontal, diagonalA, diagonalB, outSrgb, outLinear;
-    // Rhombi: pass 1 writes X (horizontal) and Y (horizontalMean), pass 2 A and B (diagonalA/B).
+    // Rhombi: pass 1 writes X (horizontal) and Z (horizontalMean), pass 2 A and B (diagonalA/B).
     Target horizontalMean;
     TargetPair firstPair, secondPair;
     Target nearHorizontal, nearA, nearB; ///< the foreground layer's blurs
@@ -353,7 +353,7 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
     // The McIntosh passes share horizontal and the diagonals, and may have remade them since:
     // the pairs follow the textures' generations, not this function's own calls.
     horizontal.ensure(format, blurSize, "horizontal / rhombi X");
-    horizontalMean.ensure(format, blurSize, "rhombi Y");
+    horizontalMean.ensure(format, blurSize, "rhombi Z");
     diagonalA.ensure(format, blurSize, "diagonal A / rhombi A");
     diagonalB.ensure(format, blurSize, "diagonal B / rhombi B");
     const gl::Framebuffer& first = firstPair.of(horizontal, horizontalMean, "rhombi pass 1");

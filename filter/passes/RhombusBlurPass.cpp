@@ -44,18 +44,24 @@ bool alongAxis(float degrees)
 
 } // namespace
 
-/// The tap mode of pass 1's two lines and pass 2's two lines, in that order. A line crossed later
-/// by a line along another off-axis direction must be smooth (bilinear); a line crossing such a
-/// line takes the bilinear pair (rhombus_blur.frag). Lines on an axis, and lines crossing only
-/// an axis line, are exact with unfiltered taps.
-std::array<RhombusBlurPass::LineMode, 4> RhombusBlurPass::lineModes(const Directions& d)
+/// The tap modes of each line. A line crossed later by a line along another off-axis direction
+/// must be smooth (bilinear); a line crossing such a line takes the bilinear pair
+/// (rhombus_blur.frag). Lines on an axis, and lines crossing only an axis line, are exact with
+/// unfiltered taps, but for u3 over X: with u1 on an axis, bilinear taps there make the seams
+/// where its rhombus meets the third one's (whose pair of taps softens its edges) match better.
+RhombusBlurPass::LineModes RhombusBlurPass::lineModes(const Directions& d)
 {
     const bool axis1 = alongAxis(d.u1), axis2 = alongAxis(d.u2), axis3 = alongAxis(d.u3);
     return {
-        axis1 ? LineMode::Point : LineMode::Smooth,               // u1 of the source: X, crossed by u2 and u3
-        axis2 ? LineMode::Point : LineMode::Smooth,               // u2 of the source: in Y, crossed by u3
-        axis1 || axis2 ? LineMode::Point : LineMode::Pair,        // u2 over X
-        axis3 ? LineMode::Point : (axis1 && axis2 ? LineMode::Smooth : LineMode::Pair), // u3 over Y
+        {
+            axis1 ? LineMode::Point : LineMode::Smooth, // u1 of the source: X, crossed by u2 and u3
+            axis2 ? LineMode::Point : LineMode::Smooth, // u2 of the source: Z, crossed by u3
+        },
+        {
+            axis1 || axis2 ? LineMode::Point : LineMode::Pair,                                 // u2 over X
+            axis2 || axis3 ? LineMode::Point : LineMode::Pair,                                 // u3 over Z
+            axis3 ? LineMode::Point : (axis1 ? LineMode::Smooth : LineMode::Pair),             // u3 over X
+        },
     };
 }
 
@@ -69,24 +75,28 @@ RhombusBlurPass::RhombusBlurPass()
       nearest_(GL_NEAREST, "rhombus blur nearest", GL_MIRRORED_REPEAT)
 {
     // The variants of the default rotation (a corner on top), so that no frame pays for them.
-    const auto modes = lineModes(directions(0.0f));
+    const LineModes modes = lineModes(directions(0.0f));
     for (const bool first : {true, false})
         for (const bool near : {false, true})
             for (const bool tiles : {false, true})
                 for (const bool fused : {false, true})
                     if (!(first && fused))
-                        program(first, near, tiles, modes[first ? 0 : 2], modes[first ? 1 : 3], kDefaultTaps, fused);
+                        program(first, near, tiles, first ? modes.first[0] : modes.second[0],
+                                first ? modes.first[1] : modes.second[1], modes.second[2], kDefaultTaps, fused);
 }
 
 const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, LineMode line1, LineMode line2,
-                                            int taps, bool fused)
+                                            LineMode line3, int taps, bool fused)
 {
+    if (first)
+        line3 = LineMode::Point; // unused
     const int key = (first ? 1 : 0) | (near ? 2 : 0) | (tiles ? 4 : 0) | static_cast<int>(line1) << 3 |
-                    static_cast<int>(line2) << 5 | (fused ? 1 << 7 : 0) | taps << 8;
+                    static_cast<int>(line2) << 5 | (fused ? 1 << 7 : 0) | taps << 8 | static_cast<int>(line3) << 16;
     gl::Program& slot = programs_[key];
     if (slot.id() == 0) {
         std::vector<std::string> defines{fmt::format("LINE1_MODE {}", static_cast<int>(line1)),
                                          fmt::format("LINE2_MODE {}", static_cast<int>(line2)),
+                                         fmt::format("LINE3_MODE {}", static_cast<int>(line3)),
                                          fmt::format("MAX_TAPS {}", taps)};
         if (first)
             defines.emplace_back("FIRST_PASS 1");
@@ -94,9 +104,10 @@ const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, L
             defines.emplace_back("NEAR_FIELD 1");
         if (fused)
             defines.emplace_back("FUSED 1");
-        const std::string name = fmt::format("rhombus_blur{}{}{}{} {}{} x{}", first ? " first" : " second",
+        const std::string name = fmt::format("rhombus_blur{}{}{}{} {}{}{} x{}", first ? " first" : " second",
                                              fused ? " fused" : "", near ? " near" : "", tiles ? " tiles" : "",
-                                             static_cast<int>(line1), static_cast<int>(line2), taps);
+                                             static_cast<int>(line1), static_cast<int>(line2),
+                                             static_cast<int>(line3), taps);
         slot = gl::Program(tiles ? "tiles.vert" : "fullscreen.vert", "rhombus_blur.frag", name, defines);
     }
     return slot;
@@ -131,11 +142,13 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
     Uniforms u{};
     step(line1, width, height, &u.directions[0], u.baseSteps[0]);
     step(line2, width, height, &u.directions[2], u.baseSteps[1]);
-    const auto modes = lineModes(d);
-    const LineMode mode1 = modes[first ? 0 : 2], mode2 = modes[first ? 1 : 3];
+    const LineModes modes = lineModes(d);
+    const LineMode mode1 = first ? modes.first[0] : modes.second[0];
+    const LineMode mode2 = first ? modes.first[1] : modes.second[1];
+    const LineMode mode3 = modes.second[2]; // pass 2: u3 over X, the same direction as line 2
     if (mode1 == LineMode::Pair)
         halfPixelAcross(line1, width, height, &u.across[0]);
-    if (mode2 == LineMode::Pair)
+    if (mode2 == LineMode::Pair || (!first && mode3 == LineMode::Pair))
         halfPixelAcross(line2, width, height, &u.across[2]);
     u.nearTileSize = tileSize;
     u.bleedingBias = HexBlurPass::kBleedingBias;
@@ -153,7 +166,7 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
     bindTexture(4, second.id(), linear_.id());
     if (io.nearDiameter)
         bindTexture(2, io.nearDiameter->id(), nearest_.id());
-    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, taps, fused).use();
+    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, mode3, taps, fused).use();
     if (tiles)
         tiles->draw();
     else

@@ -33,8 +33,8 @@ public:
     };
     static Directions directions(float bladeRotationDeg);
 
-    /// What a pass reads and writes. Pass 1 reads `sourceA` (the CoC target) and writes X, Y;
-    /// pass 2 reads X as `sourceA` and Y as `sourceB` and writes A, B.
+    /// What a pass reads and writes. Pass 1 reads `sourceA` (the CoC target) and writes X, Z;
+    /// pass 2 reads X as `sourceA` and Z as `sourceB` and writes A, B.
     struct Io {
         const gl::Texture& sourceA;
         const gl::Texture* sourceB; ///< pass 2 only
@@ -45,7 +45,7 @@ public:
     };
 
     RhombusBlurPass();
-    /// `first`: pass 1 (lines u1 and u2 of the CoC target) or pass 2 (u2 of X, u3 of Y).
+    /// `first`: pass 1 (lines u1 and u2 of the CoC target) or pass 2 (u2 of X, u3 of X and of Z).
     /// `taps`: most taps per line. With `tiles`, only those tiles are drawn. `fused` (pass 2
     /// only): write (A + 2B) / 3, the result, to the target's one attachment instead of A and B.
     void run(const Io& io, bool first, const Directions& directions, int taps, int tileSize,
@@ -66,10 +66,16 @@ private:
     };
     /// How a line takes its taps (rhombus_blur.frag): unfiltered, bilinear, or a bilinear pair.
     enum class LineMode { Point = 0, Smooth = 1, Pair = 2 };
-    static std::array<LineMode, 4> lineModes(const Directions& directions);
-    /// The program of one variant, compiled on first use: pass, near field, tiles, line modes.
-    const gl::Program& program(bool first, bool near, bool tiles, LineMode line1, LineMode line2, int taps,
-                               bool fused = false);
+    /// Pass 1: u1 and u2 of the source; pass 2: u2 over X, u3 over Z, u3 over X.
+    struct LineModes {
+        std::array<LineMode, 2> first;
+        std::array<LineMode, 3> second;
+    };
+    static LineModes lineModes(const Directions& directions);
+    /// The program of one variant, compiled on first use: pass, near field, tiles, line modes
+    /// (`line3`: pass 2 only).
+    const gl::Program& program(bool first, bool near, bool tiles, LineMode line1, LineMode line2, LineMode line3,
+                               int taps, bool fused = false);
     std::map<int, gl::Program> programs_;
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
