@@ -290,7 +290,7 @@ void Pipeline::Impl::prepareDepthAndPlan()
     analysis = finishAnalysis(sceneAnalysisPass.run(depth, colorTexture, srgbInput, coefficients), coefficients,
                               prepared.invalidFraction);
     const bool allInFocus = plan.allInFocus && quality.adaptive;
-    plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution);
+    plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples);
     if (color.type() == CV_8UC3 && plan.highlights && !plan.allInFocus)
         plan.highlightGain = quality.highlightGain;
     plan.allInFocus = plan.allInFocus || allInFocus;
@@ -365,7 +365,8 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
     const auto directions = RhombusBlurPass::directions(bladeRotationDeg);
     const TileList* tiles = useTiles ? &blurTiles : nullptr;
     timer.begin("rhombi-1");
-    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, directions, quality.samples, tileSize(), tiles);
+    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, directions, quality.samples, tileSize(), tiles,
+                        false, plan.unrolledTaps);
     if (useTiles)
         copyPass.run(coc.texture, copyTiles, first, true);
     timer.end();
@@ -383,7 +384,7 @@ void Pipeline::Impl::rhombiSecondPass(const gl::Framebuffer* fusedTarget)
     timer.begin("rhombi-2");
     rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, target}, false,
                         RhombusBlurPass::directions(bladeRotationDeg), quality.samples, tileSize(), tiles,
-                        fusedTarget != nullptr);
+                        fusedTarget != nullptr, plan.unrolledTaps);
     if (rhombiUsesTiles)
         copyPass.run(horizontal.texture, copyTiles, target, fusedTarget == nullptr);
     timer.end();

@@ -83,6 +83,9 @@ struct FramePlan {
     Resolution resolution = Resolution::Full; ///< the blur passes' size, for explain()
     /// Gain of the 8-bit highlight recovery in the CoC pass; 1 = not run (set by the pipeline).
     double highlightGain = 1.0;
+    /// Rhombi: the blur loops unrolled to the tap count, because most blurred tiles have lines
+    /// that long (rhombus_blur.frag UNROLLED); otherwise plain loops that stop at each line's end.
+    bool unrolledTaps = false;
 
     /// One line for --explain, e.g. "blur 812/1200 tiles, copy 388; hole fill on (24.1 % invalid)".
     std::string explain(const SceneAnalysis& analysis) const;
@@ -90,8 +93,10 @@ struct FramePlan {
 
 /// `nearField`: spread foreground blur when the frame has some: McIntosh runs the foreground
 /// layer on nearTiles; the rhombus blur reaches over them itself, so they join blurTiles.
-/// `resolution` Half also sorts the tiles for the upscale (detailTiles).
+/// `resolution` Half also sorts the tiles for the upscale (detailTiles). `taps` (rhombi): the
+/// most taps per line, for unrolledTaps; 0 leaves the loops plain.
 FramePlan makePlan(const SceneAnalysis& analysis, bool nearField = true,
-                   HexagonKernel kernel = HexagonKernel::McIntoshMin, Resolution resolution = Resolution::Full);
+                   HexagonKernel kernel = HexagonKernel::McIntoshMin, Resolution resolution = Resolution::Full,
+                   int taps = 0);
 
 } // namespace defocus

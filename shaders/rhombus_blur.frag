@@ -114,10 +114,17 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
     vec3 foreground = vec3(0.0), foreground2 = vec3(0.0);
     float coverage = 0.0;
 #endif
-    // MAX_TAPS is a compile-time constant so that the compiler can unroll the loop.
+    // UNROLLED: MAX_TAPS is a compile-time constant, so the compiler unrolls the loop, and
+    // llvmpipe then runs every tap for every pixel (masked); the plain loop runs only as many as
+    // the longest line among the pixels it shades together, with a loop's overhead per tap. The
+    // plan takes the unrolled form where most lines run to MAX_TAPS anyway (Pipeline.cpp).
+#ifdef UNROLLED
     for (int k = 1; k <= MAX_TAPS; ++k) {
         if (k > taps)
             break;
+#else
+    for (int k = 1; k <= taps; ++k) {
+#endif
         const float distance = float(k) * step;
         const vec2 coords = vUv + direction * distance;
         const vec4 tap = fetchTap(source, smoothSource, mode, coords, across, smoothing);

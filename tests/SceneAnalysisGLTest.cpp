@@ -90,5 +90,31 @@ TEST_F(SceneAnalysisGL, MatchesTheCpuOnAFrameOfOddSize)
     expectSameMeasurement(color, depth, cocCoefficients(lens, color.cols));
 }
 
+TEST(ScenePlan, TapLoopsUnrollWhereMostLinesRunToTheLastTap)
+{
+    // Four blurred tiles; a line is half the tile's largest |CoC| (and half that again at half
+    // size). With 6 taps a line of 4.5 px or more counts as running to the last tap.
+    SceneAnalysis analysis;
+    analysis.tiles = {4, 1};
+    analysis.tileMinCoc = (cv::Mat_<float>(1, 4) << 2.0f, 2.0f, 2.0f, -20.0f);
+    analysis.tileMaxCoc = (cv::Mat_<float>(1, 4) << 9.0f, 9.0f, 4.0f, 3.0f);
+    analysis.tileNearDiameter = cv::Mat::zeros(1, 4, CV_32F);
+    analysis.minCoc = -20.0f;
+    analysis.maxCoc = 9.0f;
+    // Full size: lines of 4.5, 4.5, 2 and 10 px: three of four reach 4.5.
+    EXPECT_TRUE(makePlan(analysis, false, HexagonKernel::RhombiSum, Resolution::Full, 6).unrolledTaps);
+    // Half size: 2.25, 2.25, 1 and 5 px: one of four.
+    EXPECT_FALSE(makePlan(analysis, false, HexagonKernel::RhombiSum, Resolution::Half, 6).unrolledTaps);
+    // 12 taps want 9 px: only the near tile's 10 px.
+    EXPECT_FALSE(makePlan(analysis, false, HexagonKernel::RhombiSum, Resolution::Full, 12).unrolledTaps);
+    // The foreground reaching a tile lengthens its lines too (the near field).
+    analysis.tileNearDiameter.setTo(20.0f);
+    analysis.foreground = true;
+    EXPECT_TRUE(makePlan(analysis, true, HexagonKernel::RhombiSum, Resolution::Full, 12).unrolledTaps);
+    // McIntosh's passes have no such variant; no tap count, no decision.
+    EXPECT_FALSE(makePlan(analysis, true, HexagonKernel::McIntoshMin, Resolution::Full, 6).unrolledTaps);
+    EXPECT_FALSE(makePlan(analysis, true, HexagonKernel::RhombiSum, Resolution::Full).unrolledTaps);
+}
+
 } // namespace
 } // namespace defocus

@@ -80,18 +80,21 @@ RhombusBlurPass::RhombusBlurPass()
         for (const bool near : {false, true})
             for (const bool tiles : {false, true})
                 for (const bool fused : {false, true})
-                    if (!(first && fused))
-                        program(first, near, tiles, first ? modes.first[0] : modes.second[0],
-                                first ? modes.first[1] : modes.second[1], modes.second[2], kDefaultTaps, fused);
+                    for (const bool unrolled : {false, true})
+                        if (!(first && fused))
+                            program(first, near, tiles, first ? modes.first[0] : modes.second[0],
+                                    first ? modes.first[1] : modes.second[1], modes.second[2], kDefaultTaps, fused,
+                                    unrolled);
 }
 
 const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, LineMode line1, LineMode line2,
-                                            LineMode line3, int taps, bool fused)
+                                            LineMode line3, int taps, bool fused, bool unrolled)
 {
     if (first)
         line3 = LineMode::Point; // unused
     const int key = (first ? 1 : 0) | (near ? 2 : 0) | (tiles ? 4 : 0) | static_cast<int>(line1) << 3 |
-                    static_cast<int>(line2) << 5 | (fused ? 1 << 7 : 0) | taps << 8 | static_cast<int>(line3) << 16;
+                    static_cast<int>(line2) << 5 | (fused ? 1 << 7 : 0) | taps << 8 | static_cast<int>(line3) << 16 |
+                    (unrolled ? 1 << 18 : 0);
     gl::Program& slot = programs_[key];
     if (slot.id() == 0) {
         std::vector<std::string> defines{fmt::format("LINE1_MODE {}", static_cast<int>(line1)),
@@ -104,10 +107,12 @@ const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, L
             defines.emplace_back("NEAR_FIELD 1");
         if (fused)
             defines.emplace_back("FUSED 1");
-        const std::string name = fmt::format("rhombus_blur{}{}{}{} {}{}{} x{}", first ? " first" : " second",
+        if (unrolled)
+            defines.emplace_back("UNROLLED 1");
+        const std::string name = fmt::format("rhombus_blur{}{}{}{} {}{}{} x{}{}", first ? " first" : " second",
                                              fused ? " fused" : "", near ? " near" : "", tiles ? " tiles" : "",
                                              static_cast<int>(line1), static_cast<int>(line2),
-                                             static_cast<int>(line3), taps);
+                                             static_cast<int>(line3), taps, unrolled ? " unrolled" : "");
         slot = gl::Program(tiles ? "tiles.vert" : "fullscreen.vert", "rhombus_blur.frag", name, defines);
     }
     return slot;
@@ -132,7 +137,7 @@ RhombusBlurPass::Directions RhombusBlurPass::directions(float bladeRotationDeg)
 }
 
 void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int taps, int tileSize,
-                          const TileList* tiles, bool fused)
+                          const TileList* tiles, bool fused, bool unrolled)
 {
     assert(taps >= 1 && taps <= kMaxTaps);
     assert(first || io.sourceB);
@@ -166,7 +171,7 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
     bindTexture(4, second.id(), linear_.id());
     if (io.nearDiameter)
         bindTexture(2, io.nearDiameter->id(), nearest_.id());
-    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, mode3, taps, fused).use();
+    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, mode3, taps, fused, unrolled).use();
     if (tiles)
         tiles->draw();
     else

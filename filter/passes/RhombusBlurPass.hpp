@@ -48,8 +48,10 @@ public:
     /// `first`: pass 1 (lines u1 and u2 of the CoC target) or pass 2 (u2 of X, u3 of X and of Z).
     /// `taps`: most taps per line. With `tiles`, only those tiles are drawn. `fused` (pass 2
     /// only): write (A + 2B) / 3, the result, to the target's one attachment instead of A and B.
+    /// `unrolled`: the tap loop unrolled to `taps`, faster where most lines are that long
+    /// (rhombus_blur.frag).
     void run(const Io& io, bool first, const Directions& directions, int taps, int tileSize,
-             const TileList* tiles = nullptr, bool fused = false);
+             const TileList* tiles = nullptr, bool fused = false, bool unrolled = true);
 
 private:
     /// Mirrors the std140 block RhombusBlurParams in rhombus_blur.frag.
@@ -75,7 +77,7 @@ private:
     /// The program of one variant, compiled on first use: pass, near field, tiles, line modes
     /// (`line3`: pass 2 only).
     const gl::Program& program(bool first, bool near, bool tiles, LineMode line1, LineMode line2, LineMode line3,
-                               int taps, bool fused = false);
+                               int taps, bool fused, bool unrolled);
     std::map<int, gl::Program> programs_;
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
