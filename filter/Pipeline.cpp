@@ -18,6 +18,7 @@
 #include "filter/passes/CompositePass.hpp"
 #include "filter/passes/CopyPass.hpp"
 #include "filter/passes/HexBlurPass.hpp"
+#include "filter/passes/HighlightSpritePass.hpp"
 #include "filter/passes/RhombusBlurPass.hpp"
 #include "filter/passes/SceneAnalysisPass.hpp"
 #include "filter/passes/NearBlurPass.hpp"
@@ -101,6 +102,7 @@ struct Pipeline::Impl {
     gl::VertexArray vao = gl::VertexArray::create();
     CocPass cocPass;
     SceneAnalysisPass sceneAnalysisPass;
+    HighlightSpritePass highlightSpritePass;
     HexBlurPass hexBlurPass;
     RhombusBlurPass rhombusBlurPass;
     CompositePass compositePass;
@@ -293,6 +295,11 @@ void Pipeline::Impl::prepareDepthAndPlan()
     plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples);
     if (color.type() == CV_8UC3 && plan.highlights && !plan.allInFocus)
         plan.highlightGain = quality.highlightGain;
+    // Sprites where a blurred pixel can be brighter than white: float input's highlights, or
+    // 8-bit ones scaled up by the gain.
+    plan.highlightSprites = quality.highlightSprites && quality.kernel == HexagonKernel::RhombiSum &&
+                            plan.highlights && !plan.allInFocus &&
+                            (color.type() != CV_8UC3 || plan.highlightGain > 1.0);
     plan.allInFocus = plan.allInFocus || allInFocus;
 }
 
@@ -444,7 +451,8 @@ void Pipeline::Impl::render()
     timer.begin(CocPass::kName);
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
     cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
-                blurShift != 0);
+                blurShift != 0, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
+                &sceneAnalysisPass.measurement());
     timer.end();
     rhombiSecondPending = false;
     if (quality.kernel == HexagonKernel::RhombiSum)
@@ -515,6 +523,14 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
     }
     if (!fused)
         p.timer.end();
+    if (view == View::Composite && p.plan.highlightSprites) {
+        p.timer.begin(HighlightSpritePass::kName);
+        p.highlightSpritePass.run(p.colorTexture, p.depth, p.coefficients, static_cast<float>(p.plan.highlightGain),
+                                  CocPass::largestColor(p.quality.targetFormat == TargetFormat::Rgba16F),
+                                  p.bladeRotationDeg, p.plan.nearField, p.sceneAnalysisPass.measurement(),
+                                  p.analysis.highlightPixels, out.framebuffer);
+        p.timer.end();
+    }
 
     cv::Mat image(p.size, encoding == Encoding::Srgb8 ? CV_8UC3 : CV_32FC3);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, out.framebuffer.id());

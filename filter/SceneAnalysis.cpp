@@ -124,6 +124,7 @@ SceneAnalysis finishAnalysis(const SceneMeasurement& m, const CocCoefficients& k
         cv::dilate(a.tileNearDiameter, a.tileNearDiameter,
                    cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
     }
+    a.highlightPixels = m.highlightPixels;
     a.highlightFraction = static_cast<double>(m.highlightPixels) / static_cast<double>(m.pixels);
     return a;
 }
@@ -206,7 +207,9 @@ std::string FramePlan::explain(const SceneAnalysis& analysis) const
         text += unrolledTaps ? "; tap loops unrolled" : "; tap loops plain";
     text += nearField ? fmt::format("; near field on {} tiles", nearTiles.size())
                       : foreground ? "; foreground blur, near field off" : "; no foreground blur, near field off";
-    text += highlights ? fmt::format("; highlights {:.2f} %", 100.0 * analysis.highlightFraction) : "; no highlights";
+    text += highlights ? fmt::format("; highlights {:.2f} %{}", 100.0 * analysis.highlightFraction,
+                                     highlightSprites ? " (bokeh sprites)" : "")
+                       : "; no highlights";
     if (highlightGain > 1.0)
         text += fmt::format(" (recovered x{:g})", highlightGain);
     return text;

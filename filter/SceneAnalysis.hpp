@@ -33,6 +33,7 @@ struct SceneAnalysis {
     /// tile, i.e. the tiles' foreground maxima dilated by the reach of the largest one.
     cv::Mat tileNearDiameter;
     double highlightFraction = 0.0; ///< pixels above the highlight threshold
+    std::size_t highlightPixels = 0; ///< the same, counted
     double invalidDepthFraction = 0.0;
 
     /// Largest |CoC| of the frame.
@@ -83,6 +84,9 @@ struct FramePlan {
     Resolution resolution = Resolution::Full; ///< the blur passes' size, for explain()
     /// Gain of the 8-bit highlight recovery in the CoC pass; 1 = not run (set by the pipeline).
     double highlightGain = 1.0;
+    /// Rhombi: the light of blurred pixels above white goes to bokeh sprites (set by the pipeline
+    /// for frames with highlights that can be that bright).
+    bool highlightSprites = false;
     /// Rhombi: the blur loops unrolled to the tap count, because most blurred tiles have lines
     /// that long (rhombus_blur.frag UNROLLED); otherwise plain loops that stop at each line's end.
     bool unrolledTaps = false;

@@ -122,6 +122,11 @@ struct QualitySettings {
     /// bright hexagons. 1 = off (the default). Runs only on frames with clipped pixels; float
     /// input keeps its own HDR values.
     double highlightGain = 1.0;
+    /// Rhombi: blurred pixels brighter than white (linear luminance 1: float input's HDR lights,
+    /// 8-bit input's recovered ones) keep that much in the gather and scatter the rest as
+    /// hexagons with exact edges (bokeh sprites), added to the result. Runs only on frames with
+    /// such pixels.
+    bool highlightSprites = true;
 };
 
 /// What the pipeline writes out. The first five are the McIntosh lab's modes 1-5.

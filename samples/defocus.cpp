@@ -370,6 +370,10 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_flag("--near-field,!--no-near-field", o.quality.nearField,
                  "Spread blurred foreground over what is behind it [default: from --quality]");
+    app.add_flag("--highlight-sprites,!--no-highlight-sprites", o.quality.highlightSprites,
+                 "Rhombi: lights brighter than white scatter as hexagons with exact edges (bokeh sprites) "
+                 "[default: on]")
+        ->capture_default_str();
     app.add_flag("--always-on", alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
     app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
     app.add_flag("--demo", o.demo,

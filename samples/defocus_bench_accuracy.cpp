@@ -57,6 +57,7 @@ struct Options {
     bool noReference = false;
     bool noTimers = false;
     bool saveOutputs = false; ///< write every setting's linear result to --out/outputs/*.exr
+    bool noHighlightSprites = false; ///< the rhombi without their bokeh sprites
     std::string replot; ///< accuracy.json of an earlier run: draw its Pareto plot only
     double bladeRotationDeg = 0.0; ///< the GPU methods' hexagon; 0 = a corner on top, as the truth
     std::string scene = "blender"; ///< or "synthetic[:NAME]": input and truth rendered (docs/synthetic.md)
@@ -143,7 +144,7 @@ std::vector<std::pair<const MethodInfo*, MethodSettings>> sweep(const Options& o
         for (const Resolution resolution : {Resolution::Full, Resolution::Half})
             for (const TargetFormat precision : {TargetFormat::Rgba16F, TargetFormat::Rgba32F})
                 for (const int samples : info.samples)
-                    list.push_back({&info, MethodSettings{samples, resolution, precision}});
+                    list.push_back({&info, MethodSettings{samples, resolution, precision, !options.noHighlightSprites}});
     }
     return list;
 }
@@ -793,6 +794,8 @@ int main(int argc, char** argv)
         ->check(CLI::Range(-180.0, 180.0))
         ->capture_default_str();
     app.add_flag("--no-timers", options.noTimers, "no GL timer queries");
+    app.add_flag("--no-highlight-sprites", options.noHighlightSprites,
+                 "the rhombi without bokeh sprites for lights (what they bought)");
     app.add_flag("--save-outputs", options.saveOutputs,
                  "also write every setting's result, linear float, to --out/outputs/LABEL.exr");
     app.add_option("--replot", options.replot, "only redraw --out/pareto.png from an earlier run's accuracy.json");

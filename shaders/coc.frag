@@ -11,10 +11,11 @@
 // Blender scene (rhombi-near, 6 taps, before the upscale prefilter was clamped): 33.10 dB,
 // against 33.01 for the top-left pixel's CoC (the nearest-neighbour resize of the depth), 33.02
 // for the nearest pixel's and 32.91 for the mean.
-// The last row and column repeat on frames of odd size. HIGHLIGHTS (with highlightGain > 1):
-// the variant that recovers highlights pixel by pixel before the mean.
+// The last row and column repeat on frames of odd size. HIGHLIGHTS (with highlightGain > 1, or
+// bokeh sprites): the variant that treats highlights pixel by pixel before the mean.
 #include "common.glsl"
 #include "coc_params.glsl"
+#include "highlights.glsl"
 
 layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
@@ -23,25 +24,13 @@ layout(binding = 0) uniform sampler2D uColor; // sRGB8 textures decode to linear
 layout(binding = 1) uniform sampler2D uDepth; // metres, holes already filled
 layout(binding = 2) uniform sampler2D uColorSmooth; // uColor, filtered
 
-// Highlights from 8-bit video (issue 6): a light clipped at 255 is far brighter than 1.0, and a
-// blur of its clipped value spreads a dull grey. Pixels whose brightest channel is within the
-// top 4 % of the range are scaled up towards highlightGain, smoothly from 0.96 to 1.0 (linear),
-// so that lights bloom into bright polygons; only where the pixel will be blurred (|CoC| >= 1 px),
-// so that pixels in focus stay as they are.
-vec3 recoverHighlight(vec3 color, float coc)
-{
-    if (highlightGain <= 1.0 || abs(coc) < 1.0)
-        return color;
-    const float peak = max(color.r, max(color.g, color.b));
-    return color * mix(1.0, highlightGain, smoothstep(0.96, 1.0, peak));
-}
-
-// Colour (highlights recovered, sanitised) and CoC of one pixel of the frame.
+// Colour (highlights recovered, sanitised, the sprites' share taken out) and CoC of one pixel of
+// the frame.
 vec4 pixel(ivec2 texel)
 {
-    const vec3 color = texelFetch(uColor, texel, 0).rgb;
     const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
-    return vec4(sanitizeColor(recoverHighlight(color, coc), largestColor), coc);
+    const vec3 color = blurColor(texelFetch(uColor, texel, 0).rgb, coc);
+    return vec4(color * gatherShare(color, coc, texel, textureSize(uColor, 0)), coc);
 }
 
 // The CoC of the four with the smallest |CoC|.

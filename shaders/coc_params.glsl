@@ -10,6 +10,9 @@ layout(std140, binding = 0) uniform CocParams {
     int inverseDepth;
     float largestColor;  // 65504 for half-float targets
     float highlightGain; // 8-bit input: near-clipped pixels that get blurred are scaled up to this
+    // Luminance above which a blurred pixel's light goes to a bokeh sprite (highlights.glsl);
+    // 0: none does.
+    float highlightThreshold;
 };
 
 float signedCoc(float z)

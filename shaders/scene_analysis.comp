@@ -25,10 +25,11 @@ layout(binding = 1) uniform sampler2D uColor;
 const int kTileSize = 16;
 const int kEdges = 8;
 const float kHistogramEdges[kEdges] = float[](0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0);
-const int kWordsPerTile = 12;
+const int kWordsPerTile = 13;
 
 // Per tile, rows of tiles top to bottom: min depth, max depth (float bits), the pixels with
-// |CoC| >= each edge (8), highlight pixels, pixels.
+// |CoC| >= each edge (8), highlight pixels, pixels, the sum of their luminance (float bits; the
+// bokeh sprites compare a pixel with its tile's mean: highlights.glsl).
 layout(std430, binding = 0) writeonly buffer Measurement {
     uint words[];
 };
@@ -46,6 +47,7 @@ void main()
     float lo = 3.4e38, hi = 0.0;
     uint reach[kEdges] = uint[](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u);
     uint highlights = 0u;
+    float luminance = 0.0;
     for (int y = origin.y; y < end.y; ++y)
         for (int x = origin.x; x < end.x; ++x) {
             const float z = texelFetch(uDepth, ivec2(x, y), 0).r;
@@ -55,6 +57,7 @@ void main()
             for (int i = 0; i < kEdges; ++i)
                 reach[i] += c >= kHistogramEdges[i] ? 1u : 0u;
             const vec3 color = texelFetch(uColor, ivec2(x, y), 0).rgb;
+            luminance += dot(color, vec3(0.2126, 0.7152, 0.0722));
 #ifdef EIGHT_BIT
             highlights += max(color.r, max(color.g, color.b)) >= 0.9516 ? 1u : 0u;
 #else
@@ -69,4 +72,5 @@ void main()
         words[base + 2u + uint(i)] = reach[i];
     words[base + 10u] = highlights;
     words[base + 11u] = uint((end.x - origin.x) * (end.y - origin.y));
+    words[base + 12u] = floatBitsToUint(luminance);
 }

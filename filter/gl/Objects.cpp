@@ -107,6 +107,12 @@ StorageBuffer::StorageBuffer(GLsizeiptr size, std::string_view name) : size_(siz
     label(GL_BUFFER, id, name);
 }
 
+void StorageBuffer::update(const void* data, GLsizeiptr bytes)
+{
+    assert(bytes <= size_);
+    glNamedBufferSubData(id(), 0, bytes, data);
+}
+
 void StorageBuffer::bind(GLuint binding) const
 {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, id());

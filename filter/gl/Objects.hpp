@@ -139,6 +139,8 @@ public:
     StorageBuffer() = default;
     StorageBuffer(GLsizeiptr size, std::string_view name);
     GLsizeiptr size() const { return size_; }
+    /// Replaces the first `bytes`.
+    void update(const void* data, GLsizeiptr bytes);
     void bind(GLuint binding) const;
     /// Copies `bytes` from the start into `data`; waits for the GPU's writes to finish.
     void read(void* data, GLsizeiptr bytes) const;

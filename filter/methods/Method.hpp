@@ -33,6 +33,8 @@ struct MethodSettings {
     Resolution resolution = Resolution::Full;
     /// Precision of the intermediate and output render targets of GPU methods.
     TargetFormat precision = TargetFormat::Rgba16F;
+    /// The rhombi: bokeh sprites for lights (QualitySettings::highlightSprites).
+    bool highlightSprites = true;
 };
 
 std::string_view precisionName(TargetFormat format);    ///< "16F", "32F"

@@ -28,6 +28,7 @@ QualitySettings PipelineMethod::quality(std::string_view name, const MethodSetti
     quality.targetFormat = settings.precision;
     quality.resolution = settings.resolution;
     quality.adaptive = true;
+    quality.highlightSprites = settings.highlightSprites;
     return quality;
 }
 

@@ -1,6 +1,7 @@
 // CoC pass: uploads the lens coefficients and draws coc.frag.
 #include "filter/passes/CocPass.hpp"
 
+#include <cassert>
 #include <limits>
 
 #include "filter/passes/HexBlurPass.hpp"
@@ -32,24 +33,32 @@ float CocPass::largestColor(bool halfTarget)
     return halfTarget ? kLargestHalf : kLargestFloat;
 }
 
-CocPass::Uniforms CocPass::uniforms(const CocCoefficients& k, bool halfTarget, float highlightGain)
+CocPass::Uniforms CocPass::uniforms(const CocCoefficients& k, bool halfTarget, float highlightGain,
+                                    float highlightThreshold)
 {
     return {{k.nearScale, k.nearOffset, k.farScale, k.farOffset},
             k.focusM,
             k.maxCocPx,
             k.inverseDepth ? 1 : 0,
             largestColor(halfTarget),
-            highlightGain};
+            highlightGain,
+            highlightThreshold};
 }
 
 void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-                  const gl::Framebuffer& target, float highlightGain, bool halfSize)
+                  const gl::Framebuffer& target, float highlightGain, bool halfSize, float highlightThreshold,
+                  const gl::StorageBuffer* measurement)
 {
-    const Uniforms u = uniforms(k, halfTarget, highlightGain);
+    assert(highlightThreshold <= 0.0f || measurement);
+    if (measurement)
+        measurement->bind(1);
+    const Uniforms u = uniforms(k, halfTarget, highlightGain, highlightThreshold);
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();
-    (!halfSize ? program_ : highlightGain > 1.0f ? halfHighlightsProgram_ : halfProgram_).use();
+    // Highlights are treated pixel by pixel: at half size, four fetches instead of one mean.
+    const bool highlights = highlightGain > 1.0f || highlightThreshold > 0.0f;
+    (!halfSize ? program_ : highlights ? halfHighlightsProgram_ : halfProgram_).use();
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
     bindTexture(2, color.id(), linear_.id());

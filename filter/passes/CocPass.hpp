@@ -19,8 +19,12 @@ public:
     /// `highlightGain` > 1 scales near-clipped pixels of 8-bit input that get blurred (coc.frag).
     /// `halfSize`: the target is ((w + 1) / 2, (h + 1) / 2) and each texel averages 2x2 pixels,
     /// its CoC in half-size pixels.
+    /// `highlightThreshold` > 0: blurred pixels brighter than this that stand out of their tile
+    /// keep only that much luminance (their rest goes to bokeh sprites, HighlightSpritePass);
+    /// `measurement` is then the scene analysis' (SceneAnalysisPass::measurement()).
     void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-             const gl::Framebuffer& target, float highlightGain = 1.0f, bool halfSize = false);
+             const gl::Framebuffer& target, float highlightGain = 1.0f, bool halfSize = false,
+             float highlightThreshold = 0.0f, const gl::StorageBuffer* measurement = nullptr);
 
     /// Mirrors the std140 block CocParams in coc_params.glsl (shared with upscale.frag).
     struct Uniforms {
@@ -30,8 +34,10 @@ public:
         int inverseDepth;
         float largestColor;
         float highlightGain;
+        float highlightThreshold;
     };
-    static Uniforms uniforms(const CocCoefficients& k, bool halfTarget, float highlightGain);
+    static Uniforms uniforms(const CocCoefficients& k, bool halfTarget, float highlightGain,
+                             float highlightThreshold = 0.0f);
 
 private:
     gl::Program program_, halfProgram_, halfHighlightsProgram_;

@@ -14,10 +14,11 @@ namespace defocus {
 namespace {
 
 // The storage buffer's layout (std430, scene_analysis.comp): per tile, min and max depth (float
-// bits), the pixels whose |CoC| reaches each histogram edge, highlight pixels, pixels.
+// bits), the pixels whose |CoC| reaches each histogram edge, highlight pixels, pixels, their
+// luminance summed (for the bokeh sprites, which read the buffer on the GPU).
 constexpr std::size_t kEdges = SceneAnalysis::kHistogramEdges.size();
 static_assert(kEdges == 8, "scene_analysis.comp has 8 edges");
-constexpr std::size_t kWordsPerTile = 12;
+constexpr std::size_t kWordsPerTile = 13;
 constexpr GLuint kTilesPerGroup = 8; // local_size_x
 
 } // namespace

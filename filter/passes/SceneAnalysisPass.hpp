@@ -18,6 +18,9 @@ public:
     /// `depth`: R32F metres with no holes; `color`: sRGB8 (`eightBit`) or float RGB, the same
     /// size. Waits for the result: the plan needs it before the blur passes are recorded.
     SceneMeasurement run(const gl::Texture& depth, const gl::Texture& color, bool eightBit, const CocCoefficients& k);
+    /// The last run's measurement as the GPU holds it (scene_analysis.comp's layout), for the
+    /// bokeh sprites' comparison of a pixel with its tile (highlights.glsl).
+    const gl::StorageBuffer& measurement() const { return measurement_; }
 
 private:
     gl::Program program_, eightBitProgram_;

@@ -1,0 +1,26 @@
+#version 450 core
+// Bokeh sprites, step 2: the hexagon's coverage of this pixel times the sprite's light, added to
+// the output (blending GL_ONE, GL_ONE), where the gather would have brought the same light: to
+// a pixel with a blur of its own (|CoC| >= 1 px), unless it lies in front of the sprite and is
+// sharper (the bleeding rule keeps background blur off sharper foreground); and with the near
+// field, from a sprite in front of the pixel and blurrier than it, whatever the pixel's blur.
+// Pixels in focus are otherwise kept, as the gather keeps them.
+#include "coc_params.glsl"
+#include "hexagon_sprite.glsl"
+
+layout(location = 0) in vec2 vOffset;
+layout(location = 1) flat in vec4 vLight;
+layout(location = 2) flat in float vRadius;
+layout(location = 0) out vec4 outColor;
+
+layout(binding = 1) uniform sampler2D uDepth; // metres, holes filled
+
+void main()
+{
+    const float sprite = vLight.a;
+    const float here = signedCoc(texelFetch(uDepth, ivec2(gl_FragCoord.xy), 0).r);
+    const bool gathers = abs(here) >= 1.0 && !(here < sprite - 2.0 && abs(here) < abs(sprite));
+    const bool foreground = nearField != 0 && sprite < here && abs(sprite) > abs(here);
+    const float coverage = gathers || foreground ? hexagonCoverage(vOffset, vRadius) : 0.0;
+    outColor = vec4(vLight.rgb * coverage, 0.0);
+}

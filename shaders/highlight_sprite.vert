@@ -1,0 +1,60 @@
+#version 450 core
+// Bokeh sprites, step 2: six triangles per sprite (highlight_sprites.comp), a hexagon just large
+// enough for the sprite's, of circumscribed diameter |CoC|, and the half pixel of its antialiased
+// edge (a quad around it shaded 38 % more pixels at 15 px).
+#include "hexagon_sprite.glsl"
+
+layout(location = 0) out vec2 vOffset;     // pixels from the sprite's centre
+layout(location = 1) flat out vec4 vLight; // rgb: light per pixel of full coverage; a: CoC
+layout(location = 2) flat out float vRadius;
+
+// Small hexagons: the coverage summed over the pixels they touch, so that the light is kept
+// exactly (the ramp's area error is not negligible below a few pixels).
+const float kSummedBelowRadius = 4.0;
+
+void main()
+{
+    const uint index = min(uint(gl_InstanceID) / 4u, capacity - 1u);
+    vec4 sprite = sprites[2u * index];
+    const vec3 light = sprites[2u * index + 1u].rgb;
+    const float radius = 0.5 * abs(sprite.z);
+    // Area of the regular hexagon, 3 sqrt(3) / 2 R^2: the light spreads evenly over it.
+    float area = 2.598076 * radius * radius;
+    if (radius < kSummedBelowRadius) {
+        area = 0.0;
+        const int reach = int(ceil(radius + 0.5));
+        for (int y = -reach; y <= reach; ++y)
+            for (int x = -reach; x <= reach; ++x)
+                area += hexagonCoverage(vec2(x, y), radius);
+    }
+    // Instances 1 to 3: the sprite mirrored in the nearer vertical edge, horizontal edge, or both,
+    // so that light a hexagon would carry out of the frame comes back in, as the gather reads the
+    // frame mirrored beyond its edges (and a bright region keeps its level up to the edges).
+    // Mirror images that do not reach into the frame are collapsed to a point.
+    const float reach = radius + 0.81;
+    const int mirror = gl_InstanceID & 3;
+    bool visible = true;
+    if ((mirror & 1) != 0) {
+        const bool left = sprite.x < 0.5 * frameSize.x;
+        visible = visible && (left ? sprite.x < reach : frameSize.x - sprite.x < reach);
+        sprite.x = left ? -sprite.x : 2.0 * frameSize.x - sprite.x;
+    }
+    if ((mirror & 2) != 0) {
+        const bool top = sprite.y < 0.5 * frameSize.y;
+        visible = visible && (top ? sprite.y < reach : frameSize.y - sprite.y < reach);
+        sprite.y = top ? -sprite.y : 2.0 * frameSize.y - sprite.y;
+    }
+    // Triangle t of the fan: the centre, corner t, corner t + 1; the corners 0.7 px beyond the
+    // hexagon's edges (0.81 px along a corner), past the ramp.
+    const int triangle = gl_VertexID / 3, vertex = gl_VertexID - 3 * triangle;
+    vOffset = vec2(0.0);
+    if (vertex != 0) {
+        const float angle = 1.0471976 * float(triangle + vertex - 1); // 60 degrees a corner
+        const vec2 direction = vec2(cos(angle) * corner.x - sin(angle) * corner.y,
+                                    sin(angle) * corner.x + cos(angle) * corner.y);
+        vOffset = visible ? direction * reach : vec2(0.0);
+    }
+    vLight = vec4(light / max(area, 1e-6), sprite.z);
+    vRadius = radius;
+    gl_Position = vec4((sprite.xy + vOffset) / frameSize * 2.0 - 1.0, 0.0, 1.0);
+}

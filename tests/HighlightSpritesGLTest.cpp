@@ -1,0 +1,136 @@
+// Bokeh sprites (HighlightSpritePass, highlight_sprites.comp, highlight_sprite.vert/.frag): the
+// light of blurred pixels above white scattered as hexagons with exact edges, only on frames with
+// such lights.
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "filter/Pipeline.hpp"
+#include "tests/GLTestSupport.hpp"
+#include "tests/TestSupport.hpp"
+
+namespace defocus {
+namespace {
+
+class HighlightSprites : public test::GLTest {
+protected:
+    static QualitySettings quality(bool sprites)
+    {
+        QualitySettings q;
+        q.samples = 12;
+        q.targetFormat = TargetFormat::Rgba32F;
+        q.highlightSprites = sprites;
+        return q;
+    }
+    /// A dark frame with one light of `energy` at `at`, everything 2 m away (CoC `coc` px).
+    static cv::Mat light(cv::Point at, float energy, cv::Size size = {96, 96})
+    {
+        cv::Mat color(size, CV_32FC3, cv::Scalar::all(0.0));
+        color.at<cv::Vec3f>(at) = cv::Vec3f::all(energy);
+        return color;
+    }
+};
+
+TEST_F(HighlightSprites, ALightBecomesAHexagonWithExactEdgesAndAllItsEnergy)
+{
+    const double diameter = 30.0;
+    const cv::Mat color = light({48, 48}, 1000.0f);
+    const cv::Mat far(color.size(), CV_32F, cv::Scalar(2.0f));
+    Pipeline pipeline;
+    const cv::Mat out = pipeline.run({color, far, 0.0, 0, "light"}, test::lensWithFarCoc(diameter), quality(true),
+                                     View::Composite, Encoding::Linear32F);
+    EXPECT_TRUE(pipeline.plan().highlightSprites);
+    cv::Mat gray;
+    cv::cvtColor(out, gray, cv::COLOR_BGR2GRAY);
+    // All of the light, in the frame: float sums over ~600 pixels, 0.5 %.
+    EXPECT_NEAR(cv::sum(gray)[0], 1000.0, 5.0);
+
+    // The exact hexagon, a corner on top, circumradius 15 px, its pixels' covered area by 16x16
+    // supersampling; the sprite's edge ramp is one pixel wide, like an area-sampled edge.
+    const double radius = diameter / 2.0, apothem = radius * std::sqrt(3.0) / 2.0;
+    cv::Mat exact(gray.size(), CV_64F, cv::Scalar(0.0));
+    for (int y = 0; y < gray.rows; ++y)
+        for (int x = 0; x < gray.cols; ++x) {
+            int inside = 0;
+            for (int sy = 0; sy < 16; ++sy)
+                for (int sx = 0; sx < 16; ++sx) {
+                    const double px = x - 48 + (sx + 0.5) / 16.0 - 0.5, py = y - 48 + (sy + 0.5) / 16.0 - 0.5;
+                    inside += std::abs(px) <= apothem && std::abs(py) + std::abs(px) / std::sqrt(3.0) <= radius;
+                }
+            exact.at<double>(y, x) = inside / 256.0;
+        }
+    exact *= 1000.0 / cv::sum(exact)[0];
+    cv::Mat difference, gray64;
+    gray.convertTo(gray64, CV_64F);
+    cv::absdiff(gray64, exact, difference);
+    double worst = 0.0;
+    cv::minMaxLoc(difference, nullptr, &worst);
+    const double plateau = 1000.0 / (3.0 * std::sqrt(3.0) / 2.0 * radius * radius);
+    // Measured against the exact hexagon: worst pixel 0.14 of the plateau (at the corners, where
+    // the ramp on the distance to the nearest edge misjudges the covered area), RMS 0.003; the
+    // rhombi alone, without sprites: worst 0.71 (bilinear taps smear the third rhombus' edges),
+    // RMS 0.042.
+    const double rms = std::sqrt(cv::mean(difference.mul(difference))[0]) / plateau;
+    std::printf("[ FIGURE   ] sprites: worst %.3f, rms %.4f of the plateau\n", worst / plateau, rms);
+    EXPECT_LT(worst / plateau, 0.2);
+    const cv::Mat without = pipeline.run({color, far, 0.0, 0, "light"}, test::lensWithFarCoc(diameter),
+                                         quality(false), View::Composite, Encoding::Linear32F);
+    cv::cvtColor(without, gray, cv::COLOR_BGR2GRAY);
+    gray.convertTo(gray64, CV_64F);
+    cv::absdiff(gray64, exact, difference);
+    double worstWithout = 0.0;
+    cv::minMaxLoc(difference, nullptr, &worstWithout);
+    const double rmsWithout = std::sqrt(cv::mean(difference.mul(difference))[0]) / plateau;
+    std::printf("[ FIGURE   ] gather alone: worst %.3f, rms %.4f of the plateau\n", worstWithout / plateau,
+                rmsWithout);
+    EXPECT_LT(rms, 0.5 * rmsWithout) << "the sprites' edges are sharper than the gather's";
+}
+
+TEST_F(HighlightSprites, ALightAtTheEdgeKeepsItsEnergyInTheFrame)
+{
+    // 2 px from the left edge, a 30 px hexagon: most of it would fall outside; the sprite's
+    // mirror image brings it back, as the gather reads the frame mirrored.
+    const cv::Mat color = light({2, 48}, 1000.0f);
+    const cv::Mat far(color.size(), CV_32F, cv::Scalar(2.0f));
+    Pipeline pipeline;
+    const cv::Mat out = pipeline.run({color, far, 0.0, 0, "edge light"}, test::lensWithFarCoc(30.0), quality(true),
+                                     View::Composite, Encoding::Linear32F);
+    cv::Mat gray;
+    cv::cvtColor(out, gray, cv::COLOR_BGR2GRAY);
+    EXPECT_NEAR(cv::sum(gray)[0], 1000.0, 10.0);
+}
+
+TEST_F(HighlightSprites, RunOnlyWhereThereAreLightsThatStandOut)
+{
+    const cv::Mat far(96, 96, CV_32F, cv::Scalar(2.0f));
+    const LensSettings lens = test::lensWithFarCoc(20.0);
+    Pipeline pipeline;
+    // Nothing above white: no sprites.
+    pipeline.run({light({48, 48}, 0.9f), far, 0.0, 0, "dim"}, lens, quality(true), View::Composite,
+                 Encoding::Linear32F);
+    EXPECT_FALSE(pipeline.plan().highlightSprites);
+    // A uniform field far above white: the plan runs the pass, but no pixel stands out of its
+    // tile, so the gather spreads it all: the field stays at its value, as without sprites.
+    const cv::Mat bright(96, 96, CV_32FC3, cv::Scalar::all(50.0));
+    const cv::Mat out = pipeline.run({bright, far, 0.0, 0, "bright"}, lens, quality(true), View::Composite,
+                                     Encoding::Linear32F);
+    EXPECT_TRUE(pipeline.plan().highlightSprites);
+    double lo = 0.0, hi = 0.0;
+    cv::minMaxLoc(out.reshape(1), &lo, &hi);
+    EXPECT_NEAR(lo, 50.0, 1e-3);
+    EXPECT_NEAR(hi, 50.0, 1e-3);
+    // 8-bit video: clipped lights are white at most, unless the highlight gain scales them up.
+    cv::Mat video(96, 96, CV_8UC3, cv::Scalar::all(40));
+    video(cv::Rect(46, 46, 3, 3)).setTo(cv::Scalar::all(255));
+    pipeline.run({video, far, 0.0, 0, "video"}, lens, quality(true), View::Composite, Encoding::Linear32F);
+    EXPECT_FALSE(pipeline.plan().highlightSprites);
+    QualitySettings gained = quality(true);
+    gained.highlightGain = 8.0;
+    pipeline.run({video, far, 0.0, 0, "video"}, lens, gained, View::Composite, Encoding::Linear32F);
+    EXPECT_TRUE(pipeline.plan().highlightSprites);
+}
+
+} // namespace
+} // namespace defocus
