@@ -296,10 +296,12 @@ void Pipeline::Impl::prepareDepthAndPlan()
     if (color.type() == CV_8UC3 && plan.highlights && !plan.allInFocus)
         plan.highlightGain = quality.highlightGain;
     // Sprites where a blurred pixel can be brighter than white: float input's highlights, or
-    // 8-bit ones scaled up by the gain.
+    // 8-bit ones scaled up by the gain; and only where such pixels are few, lights rather than
+    // bright surfaces (HighlightSpritePass::kMostHighlightPixels).
     plan.highlightSprites = quality.highlightSprites && quality.kernel == HexagonKernel::RhombiSum &&
                             plan.highlights && !plan.allInFocus &&
-                            (color.type() != CV_8UC3 || plan.highlightGain > 1.0);
+                            (color.type() != CV_8UC3 || plan.highlightGain > 1.0) &&
+                            analysis.highlightFraction <= HighlightSpritePass::kMostHighlightPixels;
     plan.allInFocus = plan.allInFocus || allInFocus;
 }
 
@@ -449,10 +451,17 @@ void Pipeline::Impl::render()
         detailTiles.set(plan.detailTiles, size, SceneAnalysis::kTileSize);
     glBindVertexArray(vao.id());
     timer.begin(CocPass::kName);
+    // The bokeh sprites are found first (in the "coc" scope): the CoC pass leaves their light out
+    // of the gather if they fit the frame's budget.
+    if (plan.highlightSprites)
+        highlightSpritePass.find(colorTexture, depth, coefficients, static_cast<float>(plan.highlightGain),
+                                 CocPass::largestColor(half), sceneAnalysisPass.measurement(),
+                                 HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
+                                                             analysis.highlightPixels));
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
     cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
                 blurShift != 0, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
-                &sceneAnalysisPass.measurement());
+                &sceneAnalysisPass.measurement(), &highlightSpritePass.sprites());
     timer.end();
     rhombiSecondPending = false;
     if (quality.kernel == HexagonKernel::RhombiSum)
@@ -525,10 +534,7 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
         p.timer.end();
     if (view == View::Composite && p.plan.highlightSprites) {
         p.timer.begin(HighlightSpritePass::kName);
-        p.highlightSpritePass.run(p.colorTexture, p.depth, p.coefficients, static_cast<float>(p.plan.highlightGain),
-                                  CocPass::largestColor(p.quality.targetFormat == TargetFormat::Rgba16F),
-                                  p.bladeRotationDeg, p.plan.nearField, p.sceneAnalysisPass.measurement(),
-                                  p.analysis.highlightPixels, out.framebuffer);
+        p.highlightSpritePass.draw(p.depth, p.coefficients, p.bladeRotationDeg, p.plan.nearField, out.framebuffer);
         p.timer.end();
     }
 

@@ -24,13 +24,20 @@ layout(binding = 0) uniform sampler2D uColor; // sRGB8 textures decode to linear
 layout(binding = 1) uniform sampler2D uDepth; // metres, holes already filled
 layout(binding = 2) uniform sampler2D uColorSmooth; // uColor, filtered
 
+// The bokeh sprites' count (highlight_sprites.comp, run before this pass): their light leaves
+// the gather only if the frame's sprites fit its budget and are drawn.
+layout(std430, binding = 2) readonly buffer SpriteCount {
+    uint spriteHeader[8]; // ..., [4] the budget, [5] the pixels that make a sprite
+};
+
 // Colour (highlights recovered, sanitised, the sprites' share taken out) and CoC of one pixel of
 // the frame.
 vec4 pixel(ivec2 texel)
 {
     const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
     const vec3 color = blurColor(texelFetch(uColor, texel, 0).rgb, coc);
-    return vec4(color * gatherShare(color, coc, texel, textureSize(uColor, 0)), coc);
+    const bool drawn = highlightThreshold > 0.0 && spriteHeader[5] <= spriteHeader[4];
+    return vec4(drawn ? color * spriteShare(color, coc, texel, textureSize(uColor, 0)) : color, coc);
 }
 
 // The CoC of the four with the smallest |CoC|.

@@ -6,7 +6,8 @@ layout(std430, binding = 0) readonly buffer Sprites {
     uint firstVertex;
     uint baseInstance;
     uint capacity;
-    uint unused[3];
+    uint found;
+    uint unused[2];
     vec4 sprites[];   // per sprite: (x, y, signed CoC, 0), (light rgb, 0)
 };
 

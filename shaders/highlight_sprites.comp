@@ -2,8 +2,8 @@
 // Bokeh sprites, step 1 of 2 (issue 6, "highlights only where there are highlights"): every
 // blurred pixel whose light the CoC pass gives to a sprite (highlights.glsl) appends one: its
 // position, CoC and that light, to a buffer that is also the instanced draw's indirect command,
-// so that no count comes back to the CPU. The buffer holds as many sprites as the scene analysis
-// counted highlight pixels, a superset of these.
+// so that no count comes back to the CPU. It holds the frame's budget of sprites; a frame with
+// more draws none (SETTLE, below).
 //
 // One sprite per pixel: merging 2x2 blocks into one sprite at their light's centre made a
 // quarter of the sprites but a staircase of the lights' edges, 1.1 dB worse on the Blender scene.
@@ -22,11 +22,22 @@ layout(std430, binding = 0) buffer Sprites {
     uint instanceCount;
     uint firstVertex;
     uint baseInstance;
-    uint capacity;
-    uint unused[3];
+    uint capacity; // the frame's budget of sprites
+    uint found;    // the pixels that make one, counted past the budget
+    uint unused[2];
     vec4 sprites[]; // per sprite: (x, y, signed CoC, 0), (light rgb, 0)
 };
 
+#ifdef SETTLE
+// One invocation after the search: a frame with more sprites than its budget draws none (the
+// CoC pass then leaves their light in the gather: coc.frag), so that the draw costs at most the
+// budget's hexagons whatever the picture.
+void main()
+{
+    if (found > capacity)
+        instanceCount = 0u;
+}
+#else
 void main()
 {
     const ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
@@ -34,14 +45,16 @@ void main()
         return;
     const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
     const vec3 color = blurColor(texelFetch(uColor, texel, 0).rgb, coc);
-    const float share = gatherShare(color, coc, texel, textureSize(uDepth, 0));
+    const float share = spriteShare(color, coc, texel, textureSize(uDepth, 0));
     if (share >= 1.0)
         return;
-    // Four instances per sprite: itself and its mirror images in the frame's edges
-    // (highlight_sprite.vert).
-    const uint index = atomicAdd(instanceCount, 4u) / 4u;
+    const uint index = atomicAdd(found, 1u);
     if (index < capacity) {
         sprites[2u * index] = vec4(vec2(texel) + 0.5, coc, 0.0);
         sprites[2u * index + 1u] = vec4(color * (1.0 - share), 0.0);
+        // Four instances per sprite: itself and its mirror images in the frame's edges
+        // (highlight_sprite.vert).
+        atomicAdd(instanceCount, 4u);
     }
 }
+#endif

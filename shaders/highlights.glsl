@@ -21,15 +21,32 @@ vec3 blurColor(vec3 color, float coc)
 }
 
 // The scene analysis' measurement of the frame (scene_analysis.comp): per tile of 16x16 pixels,
-// 13 words, the last two the pixel count and the sum of their luminance (float bits).
+// 13 words, the last three the highlight pixels (above white, or clipped 8-bit), the pixel count
+// and the sum of their luminance (float bits).
 layout(std430, binding = 1) readonly buffer SceneMeasurement {
     uint measurement[];
 };
 
-float tileMeanLuminance(ivec2 texel, ivec2 frameSize)
+int tileBase(ivec2 texel, ivec2 frameSize)
 {
     const int tilesX = (frameSize.x + 15) / 16;
-    const int base = 13 * ((texel.y / 16) * tilesX + texel.x / 16);
+    return 13 * ((texel.y / 16) * tilesX + texel.x / 16);
+}
+
+// A tile's pixels become sprites only where at most this share of them is above white: lights
+// rather than a bright surface or texture (a checkered wall in HDR made 38 % of a frame's pixels
+// sprites, 500 ms of drawing per frame).
+const float kMostSpritePixelsPerTile = 0.25;
+
+bool lightTile(ivec2 texel, ivec2 frameSize)
+{
+    const int base = tileBase(texel, frameSize);
+    return float(measurement[base + 10]) <= kMostSpritePixelsPerTile * float(measurement[base + 11]);
+}
+
+float tileMeanLuminance(ivec2 texel, ivec2 frameSize)
+{
+    const int base = tileBase(texel, frameSize);
     return uintBitsToFloat(measurement[base + 12]) / float(max(measurement[base + 11], 1u));
 }
 
@@ -44,10 +61,11 @@ const float kSpriteAboveTileMean = 1.5;
 // for light the gather spreads as well.
 const float kSpriteLightPerPixel = 1.0 / 1024.0;
 
-// The share of a blurred pixel's colour that the gather keeps: all of it up to a luminance of
-// highlightThreshold, and that much of a brighter one, whose rest a bokeh sprite scatters with
-// the hexagon's exact edges (highlight_sprite.frag). 1 where no sprite is drawn.
-float gatherShare(vec3 color, float coc, ivec2 texel, ivec2 frameSize)
+// The share of a blurred pixel's colour that the gather keeps if the pixel makes a sprite: all
+// of it up to a luminance of highlightThreshold, and that much of a brighter one, whose rest a
+// bokeh sprite scatters with the hexagon's exact edges (highlight_sprite.frag). 1 for pixels
+// that make none. (The frame's sprites are drawn only if they fit the budget: coc.frag.)
+float spriteShare(vec3 color, float coc, ivec2 texel, ivec2 frameSize)
 {
     if (highlightThreshold <= 0.0 || abs(coc) < 1.0)
         return 1.0;
@@ -55,7 +73,8 @@ float gatherShare(vec3 color, float coc, ivec2 texel, ivec2 frameSize)
     const float radius = 0.5 * abs(coc);
     const float area = 2.598076 * radius * radius; // the hexagon's, 3 sqrt(3) / 2 R^2
     return luminance - highlightThreshold >= kSpriteLightPerPixel * area &&
-                   luminance > kSpriteAboveTileMean * tileMeanLuminance(texel, frameSize)
+                   luminance > kSpriteAboveTileMean * tileMeanLuminance(texel, frameSize) &&
+                   lightTile(texel, frameSize)
                ? highlightThreshold / luminance
                : 1.0;
 }

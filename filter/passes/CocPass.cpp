@@ -2,6 +2,7 @@
 #include "filter/passes/CocPass.hpp"
 
 #include <cassert>
+#include <cstdint>
 #include <limits>
 
 #include "filter/passes/HexBlurPass.hpp"
@@ -14,6 +15,7 @@ CocPass::CocPass()
       halfProgram_("fullscreen.vert", "coc.frag", "coc half size", {"HALF_SIZE 1"}),
       halfHighlightsProgram_("fullscreen.vert", "coc.frag", "coc half size highlights", {"HALF_SIZE 1", "HIGHLIGHTS 1"}),
       uniforms_(sizeof(Uniforms), "coc params"),
+      noSprites_(8 * sizeof(std::uint32_t), "coc: no sprites"),
       nearest_(GL_NEAREST, "coc nearest"),
       linear_(GL_LINEAR, "coc linear")
 {
@@ -47,11 +49,12 @@ CocPass::Uniforms CocPass::uniforms(const CocCoefficients& k, bool halfTarget, f
 
 void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
                   const gl::Framebuffer& target, float highlightGain, bool halfSize, float highlightThreshold,
-                  const gl::StorageBuffer* measurement)
+                  const gl::StorageBuffer* measurement, const gl::StorageBuffer* sprites)
 {
-    assert(highlightThreshold <= 0.0f || measurement);
+    assert(highlightThreshold <= 0.0f || (measurement && sprites));
     if (measurement)
         measurement->bind(1);
+    (sprites ? *sprites : noSprites_).bind(2);
     const Uniforms u = uniforms(k, halfTarget, highlightGain, highlightThreshold);
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);

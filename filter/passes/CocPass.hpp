@@ -21,10 +21,12 @@ public:
     /// its CoC in half-size pixels.
     /// `highlightThreshold` > 0: blurred pixels brighter than this that stand out of their tile
     /// keep only that much luminance (their rest goes to bokeh sprites, HighlightSpritePass);
-    /// `measurement` is then the scene analysis' (SceneAnalysisPass::measurement()).
+    /// `measurement` is then the scene analysis' (SceneAnalysisPass::measurement()) and `sprites`
+    /// the sprites found (HighlightSpritePass::sprites()), whose count says whether they fit.
     void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
              const gl::Framebuffer& target, float highlightGain = 1.0f, bool halfSize = false,
-             float highlightThreshold = 0.0f, const gl::StorageBuffer* measurement = nullptr);
+             float highlightThreshold = 0.0f, const gl::StorageBuffer* measurement = nullptr,
+             const gl::StorageBuffer* sprites = nullptr);
 
     /// Mirrors the std140 block CocParams in coc_params.glsl (shared with upscale.frag).
     struct Uniforms {
@@ -42,6 +44,7 @@ public:
 private:
     gl::Program program_, halfProgram_, halfHighlightsProgram_;
     gl::UniformBuffer uniforms_;
+    gl::StorageBuffer noSprites_; ///< bound for the sprite count where there are no sprites
     gl::Sampler nearest_;
     gl::Sampler linear_;
 };
