@@ -455,7 +455,8 @@ void Pipeline::Impl::render()
     // of the gather if they fit the frame's budget.
     if (plan.highlightSprites)
         highlightSpritePass.find(colorTexture, depth, coefficients, static_cast<float>(plan.highlightGain),
-                                 CocPass::largestColor(half), sceneAnalysisPass.measurement(),
+                                 CocPass::largestColor(half), bladeRotationDeg, plan.nearField,
+                                 sceneAnalysisPass.measurement(),
                                  HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
                                                              analysis.highlightPixels));
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).

@@ -1,15 +1,4 @@
-// The bokeh sprite's hexagon, shared by highlight_sprite.vert and .frag.
-
-layout(std430, binding = 0) readonly buffer Sprites {
-    uint vertexCount; // DrawArraysIndirectCommand (highlight_sprites.comp)
-    uint instanceCount;
-    uint firstVertex;
-    uint baseInstance;
-    uint capacity;
-    uint found;
-    uint unused[2];
-    vec4 sprites[];   // per sprite: (x, y, signed CoC, 0), (light rgb, 0)
-};
+// The bokeh sprite's hexagon, shared by highlight_sprites.comp and highlight_sprite.vert/.frag.
 
 layout(std140, binding = 1) uniform SpriteParams {
     vec2 frameSize; // pixels
@@ -28,4 +17,21 @@ float hexagonCoverage(vec2 offset, float radius)
     const float distance =
         max(abs(dot(offset, n0)), max(abs(dot(offset, n1)), abs(dot(offset, n2)))) - 0.866025 * radius;
     return clamp(0.5 - distance, 0.0, 1.0);
+}
+
+// Below this circumradius the light is divided by the coverage summed over the pixels the
+// hexagon touches, so that it is kept exactly (the ramp's area error is not negligible below a
+// few pixels); above, by the hexagon's area, 3 sqrt(3) / 2 R^2 (within 0.7 %).
+const float kSummedBelowRadius = 4.0;
+
+float hexagonArea(float radius)
+{
+    if (radius >= kSummedBelowRadius)
+        return 2.598076 * radius * radius;
+    float area = 0.0;
+    const int reach = int(ceil(radius + 0.5));
+    for (int y = -reach; y <= reach; ++y)
+        for (int x = -reach; x <= reach; ++x)
+            area += hexagonCoverage(vec2(x, y), radius);
+    return area;
 }

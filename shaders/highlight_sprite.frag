@@ -8,6 +8,17 @@
 #include "coc_params.glsl"
 #include "hexagon_sprite.glsl"
 
+layout(std430, binding = 0) readonly buffer Sprites {
+    uint vertexCount; // DrawArraysIndirectCommand (highlight_sprites.comp)
+    uint instanceCount;
+    uint firstVertex;
+    uint baseInstance;
+    uint capacity;
+    uint found;
+    uint unused[2];
+    vec4 sprites[];   // per sprite: (x, y, signed CoC, hexagon's area), (light rgb, 0)
+};
+
 layout(location = 0) in vec2 vOffset;
 layout(location = 1) flat in vec4 vLight;
 layout(location = 2) flat in float vRadius;

@@ -4,13 +4,20 @@
 // edge (a quad around it shaded 38 % more pixels at 15 px).
 #include "hexagon_sprite.glsl"
 
+layout(std430, binding = 0) readonly buffer Sprites {
+    uint vertexCount; // DrawArraysIndirectCommand (highlight_sprites.comp)
+    uint instanceCount;
+    uint firstVertex;
+    uint baseInstance;
+    uint capacity;
+    uint found;
+    uint unused[2];
+    vec4 sprites[];   // per sprite: (x, y, signed CoC, hexagon's area), (light rgb, 0)
+};
+
 layout(location = 0) out vec2 vOffset;     // pixels from the sprite's centre
 layout(location = 1) flat out vec4 vLight; // rgb: light per pixel of full coverage; a: CoC
 layout(location = 2) flat out float vRadius;
-
-// Small hexagons: the coverage summed over the pixels they touch, so that the light is kept
-// exactly (the ramp's area error is not negligible below a few pixels).
-const float kSummedBelowRadius = 4.0;
 
 void main()
 {
@@ -18,15 +25,7 @@ void main()
     vec4 sprite = sprites[2u * index];
     const vec3 light = sprites[2u * index + 1u].rgb;
     const float radius = 0.5 * abs(sprite.z);
-    // Area of the regular hexagon, 3 sqrt(3) / 2 R^2: the light spreads evenly over it.
-    float area = 2.598076 * radius * radius;
-    if (radius < kSummedBelowRadius) {
-        area = 0.0;
-        const int reach = int(ceil(radius + 0.5));
-        for (int y = -reach; y <= reach; ++y)
-            for (int x = -reach; x <= reach; ++x)
-                area += hexagonCoverage(vec2(x, y), radius);
-    }
+    const float area = sprite.w; // hexagonArea(radius), once per sprite (highlight_sprites.comp)
     // Instances 1 to 3: the sprite mirrored in the nearer vertical edge, horizontal edge, or both,
     // so that light a hexagon would carry out of the frame comes back in, as the gather reads the
     // frame mirrored beyond its edges (and a bright region keeps its level up to the edges).

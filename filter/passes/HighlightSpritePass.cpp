@@ -44,14 +44,27 @@ HighlightSpritePass::HighlightSpritePass()
 {
 }
 
+const gl::UniformBuffer& HighlightSpritePass::spriteParams(const gl::Texture& depth, float bladeRotationDeg,
+                                                           bool nearField)
+{
+    // A corner at 90 degrees + the rotation, counter-clockwise on screen: y runs down the rows.
+    const double corner = (90.0 + bladeRotationDeg) * std::numbers::pi / 180.0;
+    const SpriteParams params{{static_cast<float>(depth.width()), static_cast<float>(depth.height())},
+                              {static_cast<float>(std::cos(corner)), static_cast<float>(-std::sin(corner))},
+                              nearField ? 1 : 0,
+                              {}};
+    spriteParams_.update(&params, sizeof params);
+    return spriteParams_;
+}
+
 std::size_t HighlightSpritePass::budget(std::size_t pixels, std::size_t highlightPixels)
 {
     return std::max<std::size_t>(1, std::min(pixels / 64, highlightPixels));
 }
 
 void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k,
-                               float highlightGain, float largestColor, const gl::StorageBuffer& measurement,
-                               std::size_t budget)
+                               float highlightGain, float largestColor, float bladeRotationDeg, bool nearField,
+                               const gl::StorageBuffer& measurement, std::size_t budget)
 {
     if (budget > capacity_) {
         capacity_ = std::bit_ceil(budget);
@@ -70,6 +83,7 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
     measurement.bind(1);
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
+    spriteParams(depth, bladeRotationDeg, nearField).bind(1);
     find_.use();
     glDispatchCompute(static_cast<GLuint>((depth.width() + 7) / 8), static_cast<GLuint>((depth.height() + 7) / 8), 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -86,14 +100,7 @@ void HighlightSpritePass::draw(const gl::Texture& depth, const CocCoefficients& 
     cocParams_.bind(0);
     sprites_.bind(0);
     bindTexture(1, depth.id(), nearest_.id());
-    // A corner at 90 degrees + the rotation, counter-clockwise on screen: y runs down the rows.
-    const double corner = (90.0 + bladeRotationDeg) * std::numbers::pi / 180.0;
-    const SpriteParams params{{static_cast<float>(depth.width()), static_cast<float>(depth.height())},
-                              {static_cast<float>(std::cos(corner)), static_cast<float>(-std::sin(corner))},
-                              nearField ? 1 : 0,
-                              {}};
-    spriteParams_.update(&params, sizeof params);
-    spriteParams_.bind(1);
+    spriteParams(depth, bladeRotationDeg, nearField).bind(1);
     target.bindForDraw();
     draw_.use();
     glEnable(GL_BLEND);

@@ -26,10 +26,12 @@ public:
     HighlightSpritePass();
     /// Step 1, before the CoC pass: finds the sprites in `color` (sRGB8 or float RGB) and `depth`
     /// (R32F metres, filled) with the CoC pass' settings (`k`, `highlightGain`, `largestColor`,
-    /// the scene analysis' `measurement`), at most `budget` of them; a frame with more draws
-    /// none, and the CoC pass (reading sprites()) then keeps all of their light.
+    /// the scene analysis' `measurement`) and the hexagon's (`bladeRotationDeg`, `nearField`), at
+    /// most `budget` of them; a frame with more draws none, and the CoC pass (reading sprites())
+    /// then keeps all of their light.
     void find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, float highlightGain,
-              float largestColor, const gl::StorageBuffer& measurement, std::size_t budget);
+              float largestColor, float bladeRotationDeg, bool nearField, const gl::StorageBuffer& measurement,
+              std::size_t budget);
     /// Step 2: adds the sprites found to `target` (the frame's size, linear or sRGB with
     /// GL_FRAMEBUFFER_SRGB) where the gather would have spread their light (`nearField`:
     /// foreground over what is behind it too). A vertex array must be bound.
@@ -43,6 +45,9 @@ public:
     static std::size_t budget(std::size_t pixels, std::size_t highlightPixels);
 
 private:
+    /// The SpriteParams block (hexagon_sprite.glsl) for a frame of `depth`'s size, updated.
+    const gl::UniformBuffer& spriteParams(const gl::Texture& depth, float bladeRotationDeg, bool nearField);
+
     gl::Program find_, settle_, draw_;
     gl::UniformBuffer cocParams_, spriteParams_;
     gl::StorageBuffer sprites_;
