@@ -73,7 +73,7 @@ struct FramePlan {
     std::vector<cv::Point> blurTiles; ///< tiles the blur passes process
     std::vector<cv::Point> copyTiles; ///< tiles only copied (in focus)
     bool holeFill = false;            ///< depth had holes to fill
-    bool highlights = false;          ///< the frame has highlights (no highlight pass yet: reported only)
+    bool highlights = false;          ///< the frame has highlights (see highlightSprites, highlightGain)
     bool foreground = false;          ///< the frame has near blur
     bool nearField = false;           ///< the foreground layer passes run
     std::vector<cv::Point> nearTiles; ///< tiles the foreground layer covers
