@@ -14,3 +14,9 @@ vec3 sanitizeColor(vec3 c, float largest)
     const bvec3 nan = bvec3(isnan(c.r), isnan(c.g), isnan(c.b));
     return clamp(mix(c, vec3(0.0), nan), vec3(0.0), vec3(largest));
 }
+
+// Rec. 709 luminance of linear RGB (filter/SceneAnalysis.cpp uses the same weights).
+float luminance(vec3 c)
+{
+    return dot(c, vec3(0.2126, 0.7152, 0.0722));
+}

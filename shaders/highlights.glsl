@@ -1,5 +1,6 @@
 // Highlights, shared by the CoC pass (coc.frag) and the bokeh sprites (highlight_sprites.comp);
 // needs coc_params.glsl and common.glsl.
+#include "scene_measurement.glsl"
 
 // Highlights from 8-bit video (issue 6): a light clipped at 255 is far brighter than 1.0, and a
 // blur of its clipped value spreads a dull grey. Pixels whose brightest channel is within the
@@ -20,18 +21,10 @@ vec3 blurColor(vec3 color, float coc)
     return sanitizeColor(recoverHighlight(color, coc), largestColor);
 }
 
-// The scene analysis' measurement of the frame (scene_analysis.comp): per tile of 16x16 pixels,
-// 13 words, the last three the highlight pixels (above white, or clipped 8-bit), the pixel count
-// and the sum of their luminance (float bits).
+// The scene analysis' measurement of the frame (scene_measurement.glsl).
 layout(std430, binding = 1) readonly buffer SceneMeasurement {
     uint measurement[];
 };
-
-int tileBase(ivec2 texel, ivec2 frameSize)
-{
-    const int tilesX = (frameSize.x + 15) / 16;
-    return 13 * ((texel.y / 16) * tilesX + texel.x / 16);
-}
 
 // A tile's pixels become sprites only where at most this share of them is above white: lights
 // rather than a bright surface or texture (a checkered wall in HDR made 38 % of a frame's pixels
@@ -40,14 +33,15 @@ const float kMostSpritePixelsPerTile = 0.25;
 
 bool lightTile(ivec2 texel, ivec2 frameSize)
 {
-    const int base = tileBase(texel, frameSize);
-    return float(measurement[base + 10]) <= kMostSpritePixelsPerTile * float(measurement[base + 11]);
+    const int base = measurementBase(texel, frameSize);
+    return float(measurement[base + kHighlightsWord]) <=
+           kMostSpritePixelsPerTile * float(measurement[base + kPixelsWord]);
 }
 
 float tileMeanLuminance(ivec2 texel, ivec2 frameSize)
 {
-    const int base = tileBase(texel, frameSize);
-    return uintBitsToFloat(measurement[base + 12]) / float(max(measurement[base + 11], 1u));
+    const int base = measurementBase(texel, frameSize);
+    return uintBitsToFloat(measurement[base + kLuminanceWord]) / float(max(measurement[base + kPixelsWord], 1u));
 }
 
 // A sprite is drawn only for a pixel more than this many times as bright as its tile's mean: a
@@ -69,12 +63,12 @@ float spriteShare(vec3 color, float coc, ivec2 texel, ivec2 frameSize)
 {
     if (highlightThreshold <= 0.0 || abs(coc) < 1.0)
         return 1.0;
-    const float luminance = dot(color, vec3(0.2126, 0.7152, 0.0722));
+    const float brightness = luminance(color);
     const float radius = 0.5 * abs(coc);
     const float area = 2.598076 * radius * radius; // the hexagon's, 3 sqrt(3) / 2 R^2
-    return luminance - highlightThreshold >= kSpriteLightPerPixel * area &&
-                   luminance > kSpriteAboveTileMean * tileMeanLuminance(texel, frameSize) &&
+    return brightness - highlightThreshold >= kSpriteLightPerPixel * area &&
+                   brightness > kSpriteAboveTileMean * tileMeanLuminance(texel, frameSize) &&
                    lightTile(texel, frameSize)
-               ? highlightThreshold / luminance
+               ? highlightThreshold / brightness
                : 1.0;
 }

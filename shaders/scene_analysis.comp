@@ -15,21 +15,20 @@
 // pixel with a channel of 250 or more, as the CPU counts them in the encoded bytes: linear 0.9560
 // for 250 and 0.9473 for 249, so the threshold sits between. Otherwise the colour is linear float
 // and a highlight has a Rec. 709 luminance above 1.
+#include "common.glsl"
 #include "coc_params.glsl"
+#include "scene_measurement.glsl"
 
 layout(local_size_x = 8) in;
 
 layout(binding = 0) uniform sampler2D uDepth; // metres, holes already filled: finite and > 0
 layout(binding = 1) uniform sampler2D uColor;
 
-const int kTileSize = 16;
 const int kEdges = 8;
 const float kHistogramEdges[kEdges] = float[](0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0);
-const int kWordsPerTile = 13;
 
-// Per tile, rows of tiles top to bottom: min depth, max depth (float bits), the pixels with
-// |CoC| >= each edge (8), highlight pixels, pixels, the sum of their luminance (float bits; the
-// bokeh sprites compare a pixel with its tile's mean: highlights.glsl).
+// scene_measurement.glsl's layout (the luminance sum: the bokeh sprites compare a pixel with its
+// tile's mean, highlights.glsl).
 layout(std430, binding = 0) writeonly buffer Measurement {
     uint words[];
 };
@@ -47,7 +46,7 @@ void main()
     float lo = 3.4e38, hi = 0.0;
     uint reach[kEdges] = uint[](0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u);
     uint highlights = 0u;
-    float luminance = 0.0;
+    float luminanceSum = 0.0;
     for (int y = origin.y; y < end.y; ++y)
         for (int x = origin.x; x < end.x; ++x) {
             const float z = texelFetch(uDepth, ivec2(x, y), 0).r;
@@ -57,20 +56,21 @@ void main()
             for (int i = 0; i < kEdges; ++i)
                 reach[i] += c >= kHistogramEdges[i] ? 1u : 0u;
             const vec3 color = texelFetch(uColor, ivec2(x, y), 0).rgb;
-            luminance += dot(color, vec3(0.2126, 0.7152, 0.0722));
+            const float brightness = luminance(color);
+            luminanceSum += brightness;
 #ifdef EIGHT_BIT
             highlights += max(color.r, max(color.g, color.b)) >= 0.9516 ? 1u : 0u;
 #else
-            highlights += dot(color, vec3(0.2126, 0.7152, 0.0722)) > 1.0 ? 1u : 0u;
+            highlights += brightness > 1.0 ? 1u : 0u;
 #endif
         }
 
-    const uint base = uint(tile.y * tiles.x + tile.x) * uint(kWordsPerTile);
-    words[base] = floatBitsToUint(lo);
-    words[base + 1u] = floatBitsToUint(hi);
+    const int base = measurementBase(origin, size);
+    words[base + kMinDepthWord] = floatBitsToUint(lo);
+    words[base + kMaxDepthWord] = floatBitsToUint(hi);
     for (int i = 0; i < kEdges; ++i)
-        words[base + 2u + uint(i)] = reach[i];
-    words[base + 10u] = highlights;
-    words[base + 11u] = uint((end.x - origin.x) * (end.y - origin.y));
-    words[base + 12u] = floatBitsToUint(luminance);
+        words[base + kFirstReachWord + i] = reach[i];
+    words[base + kHighlightsWord] = highlights;
+    words[base + kPixelsWord] = uint((end.x - origin.x) * (end.y - origin.y));
+    words[base + kLuminanceWord] = floatBitsToUint(luminanceSum);
 }

@@ -1,4 +1,5 @@
-// Scene analysis pass: one dispatch of 16x16 work groups, one per tile, then one read-back.
+// Scene analysis pass: one dispatch, one invocation per tile and eight tiles per work group, then
+// one read-back.
 #include "filter/passes/SceneAnalysisPass.hpp"
 
 #include <array>
@@ -13,9 +14,9 @@ namespace defocus {
 
 namespace {
 
-// The storage buffer's layout (std430, scene_analysis.comp): per tile, min and max depth (float
-// bits), the pixels whose |CoC| reaches each histogram edge, highlight pixels, pixels, their
-// luminance summed (for the bokeh sprites, which read the buffer on the GPU).
+// The storage buffer's layout (std430, shaders/scene_measurement.glsl): per tile, min and max
+// depth (float bits), the pixels whose |CoC| reaches each histogram edge, highlight pixels,
+// pixels, their luminance summed (for the bokeh sprites, which read the buffer on the GPU).
 constexpr std::size_t kEdges = SceneAnalysis::kHistogramEdges.size();
 static_assert(kEdges == 8, "scene_analysis.comp has 8 edges");
 constexpr std::size_t kWordsPerTile = 13;
