@@ -535,7 +535,7 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
         p.timer.end();
     if (view == View::Composite && p.plan.highlightSprites) {
         p.timer.begin(HighlightSpritePass::kName);
-        p.highlightSpritePass.draw(p.depth, p.coefficients, p.bladeRotationDeg, p.plan.nearField, out.framebuffer);
+        p.highlightSpritePass.draw(p.depth, out.framebuffer);
         p.timer.end();
     }
 

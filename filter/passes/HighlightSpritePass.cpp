@@ -44,8 +44,7 @@ HighlightSpritePass::HighlightSpritePass()
 {
 }
 
-const gl::UniformBuffer& HighlightSpritePass::spriteParams(const gl::Texture& depth, float bladeRotationDeg,
-                                                           bool nearField)
+void HighlightSpritePass::updateSpriteParams(const gl::Texture& depth, float bladeRotationDeg, bool nearField)
 {
     // A corner at 90 degrees + the rotation, counter-clockwise on screen: y runs down the rows.
     const double corner = (90.0 + bladeRotationDeg) * std::numbers::pi / 180.0;
@@ -54,7 +53,6 @@ const gl::UniformBuffer& HighlightSpritePass::spriteParams(const gl::Texture& de
                               nearField ? 1 : 0,
                               {}};
     spriteParams_.update(&params, sizeof params);
-    return spriteParams_;
 }
 
 std::size_t HighlightSpritePass::budget(std::size_t pixels, std::size_t highlightPixels)
@@ -83,7 +81,8 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
     measurement.bind(1);
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
-    spriteParams(depth, bladeRotationDeg, nearField).bind(1);
+    updateSpriteParams(depth, bladeRotationDeg, nearField);
+    spriteParams_.bind(1);
     find_.use();
     glDispatchCompute(static_cast<GLuint>((depth.width() + 7) / 8), static_cast<GLuint>((depth.height() + 7) / 8), 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -92,15 +91,13 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
     glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
-void HighlightSpritePass::draw(const gl::Texture& depth, const CocCoefficients& k, float bladeRotationDeg,
-                               bool nearField, const gl::Framebuffer& target)
+void HighlightSpritePass::draw(const gl::Texture& depth, const gl::Framebuffer& target)
 {
-    const CocPass::Uniforms u = CocPass::uniforms(k, false, 1.0f, kThreshold);
-    cocParams_.update(&u, sizeof u);
+    // The CoC and sprite parameters are the frame's, as find() left them.
     cocParams_.bind(0);
+    spriteParams_.bind(1);
     sprites_.bind(0);
     bindTexture(1, depth.id(), nearest_.id());
-    spriteParams(depth, bladeRotationDeg, nearField).bind(1);
     target.bindForDraw();
     draw_.use();
     glEnable(GL_BLEND);

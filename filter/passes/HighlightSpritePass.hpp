@@ -33,10 +33,10 @@ public:
               float largestColor, float bladeRotationDeg, bool nearField, const gl::StorageBuffer& measurement,
               std::size_t budget);
     /// Step 2: adds the sprites found to `target` (the frame's size, linear or sRGB with
-    /// GL_FRAMEBUFFER_SRGB) where the gather would have spread their light (`nearField`:
-    /// foreground over what is behind it too). A vertex array must be bound.
-    void draw(const gl::Texture& depth, const CocCoefficients& k, float bladeRotationDeg, bool nearField,
-              const gl::Framebuffer& target);
+    /// GL_FRAMEBUFFER_SRGB) where the gather would have spread their light (with the near field:
+    /// foreground over what is behind it too), with find()'s settings; `depth` is find()'s. A
+    /// vertex array must be bound.
+    void draw(const gl::Texture& depth, const gl::Framebuffer& target);
     /// The sprites and their count, as the GPU holds them (highlight_sprites.comp).
     const gl::StorageBuffer& sprites() const { return sprites_; }
 
@@ -45,8 +45,8 @@ public:
     static std::size_t budget(std::size_t pixels, std::size_t highlightPixels);
 
 private:
-    /// The SpriteParams block (hexagon_sprite.glsl) for a frame of `depth`'s size, updated.
-    const gl::UniformBuffer& spriteParams(const gl::Texture& depth, float bladeRotationDeg, bool nearField);
+    /// Fills the SpriteParams block (hexagon_sprite.glsl) for a frame of `depth`'s size.
+    void updateSpriteParams(const gl::Texture& depth, float bladeRotationDeg, bool nearField);
 
     gl::Program find_, settle_, draw_;
     gl::UniformBuffer cocParams_, spriteParams_;
