@@ -16,10 +16,13 @@ namespace {
 
 // The storage buffer's layout (std430, shaders/scene_measurement.glsl): per tile, min and max
 // depth (float bits), the pixels whose |CoC| reaches each histogram edge, highlight pixels,
-// pixels, their luminance summed (for the bokeh sprites, which read the buffer on the GPU).
+// pixels, their luminance summed (for the bokeh sprites, which read the buffer on the GPU); the
+// word names are the shader's.
 constexpr std::size_t kEdges = SceneAnalysis::kHistogramEdges.size();
 static_assert(kEdges == 8, "scene_analysis.comp has 8 edges");
 constexpr std::size_t kWordsPerTile = 13;
+constexpr std::size_t kMinDepthWord = 0, kMaxDepthWord = 1, kFirstReachWord = 2, kHighlightsWord = 10,
+                      kPixelsWord = 11;
 constexpr GLuint kTilesPerGroup = 8; // local_size_x
 
 } // namespace
@@ -64,12 +67,12 @@ SceneMeasurement SceneAnalysisPass::run(const gl::Texture& depth, const gl::Text
         for (int x = 0; x < m.tiles.width; ++x) {
             const std::uint32_t* tile =
                 words.data() + kWordsPerTile * static_cast<std::size_t>(y * m.tiles.width + x);
-            std::memcpy(&m.tileMinDepth.at<float>(y, x), &tile[0], sizeof(float));
-            std::memcpy(&m.tileMaxDepth.at<float>(y, x), &tile[1], sizeof(float));
+            std::memcpy(&m.tileMinDepth.at<float>(y, x), &tile[kMinDepthWord], sizeof(float));
+            std::memcpy(&m.tileMaxDepth.at<float>(y, x), &tile[kMaxDepthWord], sizeof(float));
             for (std::size_t i = 0; i < kEdges; ++i)
-                reach[i] += tile[2 + i];
-            m.highlightPixels += tile[10];
-            m.pixels += tile[11];
+                reach[i] += tile[kFirstReachWord + i];
+            m.highlightPixels += tile[kHighlightsWord];
+            m.pixels += tile[kPixelsWord];
         }
     // Bin b holds the pixels that reach edge b - 1 but not edge b.
     std::size_t previous = m.pixels;
