@@ -1,6 +1,7 @@
 // The McIntosh passes checked analytically on llvmpipe: zero CoC is the identity, a point light
 // becomes a hexagon of the predicted size and orientation, constant depth blurs uniformly.
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -95,6 +96,51 @@ TEST_F(Passes, PointLightBecomesAFlatTopHexagonOfThePredictedArea)
             const bool inside = dy <= std::sqrt(3.0) / 2.0 * r && std::sqrt(3.0) * dx + dy <= std::sqrt(3.0) * r;
             EXPECT_TRUE(inside) << "light at (" << x << ", " << y << ")";
         }
+}
+
+// McIntosh's chain where near and far blur of the same size meet (left half 0.4 m, CoC -12 px;
+// right half 3 m, +12 px). The paper blurs by the CoC's size, its alpha never negative.
+// Defect caught: the first pass averaging the signed CoC, which cancels near against far where
+// they meet, so that the +-120 deg passes there barely blur (measured with that defect: the
+// first pass's |CoC| fell to near 0 at the boundary, and the band there kept 2.15 times the
+// residual noise of the far side; as the paper does it, |CoC| stays 12 px and the band 1.14
+// times, from the band's mix of the two sides' blurs).
+TEST_F(Passes, NearAndFarBlurMeetingDoNotCancel)
+{
+    const cv::Size size(96, 160);
+    cv::Mat color(size, CV_32FC3);
+    cv::RNG rng(3);
+    rng.fill(color, cv::RNG::UNIFORM, 0.0, 1.0);
+    cv::Mat depth(size, CV_32F, cv::Scalar(3.0f));
+    depth.colRange(0, size.width / 2).setTo(0.4f);
+    LensSettings lens = test::lensWithFarCoc(12.0); // focal range: 0.4 m and 3 m both clamp to 12 px
+    lens.bladeRotationDeg = 30.0;                   // flat top: the first pass runs across the boundary
+    QualitySettings quality;
+    quality.kernel = HexagonKernel::McIntoshMin;
+    quality.targetFormat = TargetFormat::Rgba32F;
+    Pipeline pipeline;
+    const cv::Mat out = pipeline.run({color, depth, 0.0, 0, "near meets far"}, lens, quality, View::Composite,
+                                     Encoding::Linear32F);
+    // The CoC the +-120 deg passes blur by: a mean of taps whose |CoC| are all 12 px is 12 px.
+    cv::Mat alpha;
+    cv::extractChannel(pipeline.readTarget(View::Horizontal), alpha, 3);
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(cv::abs(alpha), &lo, &hi);
+    EXPECT_NEAR(lo, 12.0, 1e-3) << "the first pass's CoC must not cancel where near meets far";
+    EXPECT_NEAR(hi, 12.0, 1e-3);
+    // What a user sees: the band where the two meet is blurred as much as the far side (the
+    // bleeding rule lets both sides' taps in: each is as blurred as the centre). Residual noise
+    // as the standard deviation of the green channel over each region, 6 x 128 px; 1.5 lies
+    // between the 1.14 measured and the defect's 2.15.
+    const auto noise = [&](cv::Rect region) {
+        cv::Scalar mean, stddev;
+        cv::meanStdDev(out(region), mean, stddev);
+        return stddev[1];
+    };
+    const double band = noise({size.width / 2 - 3, 16, 6, 128});
+    const double far = noise({size.width / 2 + 16, 16, 6, 128});
+    std::printf("[ near meets far ] residual noise: boundary band %.4f, far side %.4f\n", band, far);
+    EXPECT_LT(band, 1.5 * far);
 }
 
 // The rhombus kernel on one bright pixel: the hexagon itself, flat (every pixel inside gets the
