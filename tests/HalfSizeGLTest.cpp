@@ -51,7 +51,17 @@ TEST_F(HalfSize, OutputHasTheFrameSizeAndEveryViewToo)
         EXPECT_TRUE(test::allFinite(out)) << viewName(view);
     }
     // The intermediate targets are half size, rounded up.
-    EXPECT_EQ(pipeline.readTarget(View::Input).size(), cv::Size(49, 31));
+    const cv::Mat input = pipeline.readTarget(View::Input);
+    EXPECT_EQ(input.size(), cv::Size(49, 31));
+    // Content: the input view shows each half-size texel as 2 x 2 pixels of its colour (linear
+    // float both ways: to float rounding). Defect caught: a view that samples the half-size
+    // target at the frame's coordinates (its top-left quarter stretched) or interpolates it.
+    // PassesGLTest EveryViewShowsWhatItNames checks every view of the half-size presets.
+    const cv::Mat view = pipeline.read(View::Input, Encoding::Linear32F);
+    cv::Mat bgr, doubled;
+    cv::cvtColor(input, bgr, cv::COLOR_RGBA2BGR);
+    cv::resize(bgr, doubled, {}, 2, 2, cv::INTER_NEAREST);
+    EXPECT_LE(cv::norm(view, doubled(cv::Rect({0, 0}, frame.color.size())), cv::NORM_INF), 1e-6);
 }
 
 TEST_F(HalfSize, InputIsTheMeanOfEachBlockWithItsSharpestCoc)

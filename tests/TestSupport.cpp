@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "filter/methods/Presets.hpp"
+
 namespace defocus::test {
 
 std::filesystem::path dataDir()
@@ -50,6 +52,25 @@ LensSettings lensWithFarCoc(double diameterPx)
     lens.farLimitM = 2.0;
     lens.maxCocPx = diameterPx;
     return lens;
+}
+
+std::vector<NamedQuality> shippedPresets()
+{
+    std::vector<NamedQuality> list{{std::string(kDefaultPreset), presetSettings(kDefaultPreset)}};
+    for (const Preset& p : presets())
+        if (p.name != kDefaultPreset)
+            list.push_back({std::string(p.name), presetSettings(p.name)});
+    return list;
+}
+
+std::vector<NamedQuality> presetsAndKernels()
+{
+    std::vector<NamedQuality> list = shippedPresets();
+    list.push_back({"rhombi", QualitySettings{}});
+    QualitySettings mcintosh;
+    mcintosh.kernel = HexagonKernel::McIntoshMin;
+    list.push_back({"mcintosh", mcintosh});
+    return list;
 }
 
 bool allFinite(const cv::Mat& m)

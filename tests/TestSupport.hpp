@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -25,6 +26,17 @@ CliResult runDefocus(const std::string& arguments);
 /// A lens whose CoC at 2 m depth is exactly `diameterPx`: the focal-range model focused at 1 m,
 /// blur reaching max-coc at the far limit, 2 m.
 LensSettings lensWithFarCoc(double diameterPx);
+/// A quality setting the tests run, with the name they report it by.
+struct NamedQuality {
+    std::string name; ///< "balanced", "fast", "high", "rhombi", "mcintosh"
+    QualitySettings quality;
+};
+/// The shipped presets (filter/methods/Presets.hpp), the default (balanced) first: what users run.
+std::vector<NamedQuality> shippedPresets();
+/// The presets, then each kernel with the pipeline's plain settings (QualitySettings{}: 16 taps,
+/// 16F, full size, no near field): "rhombi" and "mcintosh", the published chain, which no
+/// preset uses.
+std::vector<NamedQuality> presetsAndKernels();
 /// True when every element of `m` (any depth, any channels) is finite.
 bool allFinite(const cv::Mat& m);
 

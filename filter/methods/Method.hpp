@@ -35,6 +35,10 @@ struct MethodSettings {
     TargetFormat precision = TargetFormat::Rgba16F;
     /// The rhombi: bokeh sprites for lights (QualitySettings::highlightSprites).
     bool highlightSprites = true;
+    /// The pipeline methods: follow the per-frame plan (QualitySettings::adaptive); false runs
+    /// every pass on every pixel, all-in-focus frames included. Ignored by the other methods,
+    /// which always run every pass.
+    bool adaptive = true;
 };
 
 std::string_view precisionName(TargetFormat format);    ///< "16F", "32F"

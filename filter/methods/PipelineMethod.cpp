@@ -27,7 +27,7 @@ QualitySettings PipelineMethod::quality(std::string_view name, const MethodSetti
     quality.samples = settings.samples;
     quality.targetFormat = settings.precision;
     quality.resolution = settings.resolution;
-    quality.adaptive = true;
+    quality.adaptive = settings.adaptive;
     quality.highlightSprites = settings.highlightSprites;
     return quality;
 }

@@ -16,7 +16,8 @@ public:
     PipelineMethod(std::string_view name, bool timers);
     const MethodInfo& info() const override { return info_; }
     /// The QualitySettings the pipeline runs with for method `name`: kernel and near field from
-    /// the name, samples, resolution and precision from `settings`, adaptive tiles on (what users get).
+    /// the name, samples, resolution, precision and the plan (on by default, what users get)
+    /// from `settings`.
     /// Throws std::invalid_argument for a name that is not one of the four.
     static QualitySettings quality(std::string_view name, const MethodSettings& settings);
     static bool handles(std::string_view name);
