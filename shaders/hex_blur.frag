@@ -30,7 +30,6 @@
 //  - where the bleeding rule leaves less than one tap's worth of weight (sharp foreground all
 //    around), the centre fills the missing weight; the paper divides by the total weight, which
 //    may be 0.
-layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
 layout(binding = 0) uniform sampler2D uSource; // rgb + CoC (px) in alpha: signed (the CoC pass) or |CoC|; linear filtering
@@ -79,14 +78,18 @@ void main()
         outColor = center;
         return;
     }
-    const float centerDepth = textureLod(uDepth, vUv, 0.0).r;
+    // The pixel centre from gl_FragCoord, not an interpolated uv: the tiles (tiles.vert) and the
+    // full-screen triangle interpolate uv with different rounding, which moved taps by an ulp and
+    // outputs by an 8-bit step between the plan and every pass on every pixel.
+    const vec2 uv = gl_FragCoord.xy / vec2(textureSize(uSource, 0));
+    const float centerDepth = textureLod(uDepth, uv, 0.0).r;
     const float centerBlur = diameter * cocToPaperUnits;
 
     vec4 sum = vec4(0.0);
     float totalWeight = 0.0;
     const int stride = tapStride(diameter);
     for (int i = 0; i < sampleCount; i += stride) {
-        const vec2 coords = vUv + offsets[i].xy * diameter;
+        const vec2 coords = uv + offsets[i].xy * diameter;
         const vec4 tap = vec4(textureLod(uSource, coords, 0.0).rgb, tapDiameter(coords));
         const float tapDepth = textureLod(uDepth, coords, 0.0).r;
         const float tapBlur = tap.a * cocToPaperUnits;

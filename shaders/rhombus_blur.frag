@@ -32,7 +32,6 @@
 // variants: llvmpipe pays for every instruction of a branch on a uniform. FUSED (second pass
 // only) writes the composite (A + 2B) / 3 itself, to one target: the output.
 
-layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outFirst;
 #ifndef FUSED
 layout(location = 1) out vec4 outSecond;
@@ -93,10 +92,19 @@ vec4 fetchTap(sampler2D source, sampler2D smoothSource, const int mode, vec2 coo
 // One line, or with `both` two lines along the same direction over two sources whose texels
 // carry the same CoC (pass 2's u3 over X and over Z): the taps' weights come from the first
 // source's CoC and serve both, so the second costs only its fetches.
+// The pixel centre in texture coordinates, from gl_FragCoord: an interpolated uv rounds
+// differently on the tiles (tiles.vert) than on the full-screen triangle, which moved taps by an
+// ulp and outputs by an 8-bit step between the plan and every pass on every pixel.
+vec2 pixelUv()
+{
+    return gl_FragCoord.xy / vec2(textureSize(uLine1, 0));
+}
+
 void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D source2, sampler2D smoothSource2,
            const int mode2, const bool both, vec2 direction, float baseStep, vec2 across, vec4 center, vec3 center2,
            float extent, out vec3 result, out vec3 result2)
 {
+    const vec2 uv = pixelUv();
     const float radius = 0.5 * abs(center.a);
     const float centerBlur = abs(center.a) * cocToPaperUnits;
     const float step = max(baseStep, extent / float(MAX_TAPS));
@@ -126,7 +134,7 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
     for (int k = 1; k <= taps; ++k) {
 #endif
         const float distance = float(k) * step;
-        const vec2 coords = vUv + direction * distance;
+        const vec2 coords = uv + direction * distance;
         const vec4 tap = fetchTap(source, smoothSource, mode, coords, across, smoothing);
         const vec3 tap2 = both ? fetchTap(source2, smoothSource2, mode2, coords, across, smoothing).rgb : vec3(0.0);
         const bool nearer = tap.a < center.a;
