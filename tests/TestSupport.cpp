@@ -54,6 +54,11 @@ LensSettings lensWithFarCoc(double diameterPx)
     return lens;
 }
 
+void PrintTo(const NamedQuality& quality, std::ostream* os)
+{
+    *os << quality.name;
+}
+
 std::vector<NamedQuality> shippedPresets()
 {
     std::vector<NamedQuality> list{{std::string(kDefaultPreset), presetSettings(kDefaultPreset)}};

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,8 @@ struct NamedQuality {
     std::string name; ///< "balanced", "fast", "high", "rhombi", "mcintosh"
     QualitySettings quality;
 };
+/// GoogleTest prints a parameter by its name.
+void PrintTo(const NamedQuality& quality, std::ostream* os);
 /// The shipped presets (filter/methods/Presets.hpp), the default (balanced) first: what users run.
 std::vector<NamedQuality> shippedPresets();
 /// The presets, then each kernel with the pipeline's plain settings (QualitySettings{}: 16 taps,
