@@ -1,7 +1,8 @@
 // Soak: many frames through the pipeline, checking that memory and GL objects stay flat.
-//   defocus-soak --frames 10000 --width 160 --height 120
+//   defocus-soak --frames 10000 --width 160 --height 120 [--quality balanced]
 // Frames alternate between two sizes every 50 frames, so target reallocation is exercised too.
-// Exits 1 when resident memory grows by more than --max-growth-mb or GL objects leak.
+// Exits 1 when resident memory grows by more than --max-growth-mb or GL objects leak, 2 on a bad
+// command line, 75 without a GL context (samples/ExitStatus.hpp).
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -13,6 +14,8 @@
 #include "filter/Pipeline.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Objects.hpp"
+#include "filter/methods/Presets.hpp"
+#include "samples/ExitStatus.hpp"
 
 namespace {
 
@@ -48,15 +51,25 @@ int main(int argc, char** argv)
     std::size_t frames = 10000;
     int width = 160, height = 120;
     double maxGrowthMiB = 4.0;
+    std::string qualityName(kDefaultPreset);
     CLI::App app{"defocus-soak: frames through the pipeline with flat memory and GL object counts"};
     app.add_option("--frames", frames, "Frames to run")->capture_default_str();
     app.add_option("--width", width, "Frame width, pixels")->capture_default_str()->check(CLI::Range(2, 8192));
     app.add_option("--height", height, "Frame height, pixels")->capture_default_str()->check(CLI::Range(2, 8192));
     app.add_option("--max-growth-mb", maxGrowthMiB, "Allowed RSS growth after warm-up, MiB")->capture_default_str();
-    CLI11_PARSE(app, argc, argv);
+    app.add_option("--quality", qualityName, "Preset the frames run with, as defocus --quality")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"fast", "balanced", "high"}));
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int status = app.exit(e); // prints the message, or the help
+        return status == 0 ? kExitDone : kExitUsage;
+    }
 
     try {
         auto context = gl::EglContext::create();
+        const QualitySettings quality = presetSettings(qualityName);
         Pipeline pipeline;
         LensSettings lens;
         lens.focusM = 2.0;
@@ -73,7 +86,7 @@ int main(int argc, char** argv)
         long objectsStart = 0;
         for (std::size_t i = 0; i < frames; ++i) {
             const int s = static_cast<int>((i / 50) % 2);
-            const cv::Mat out = pipeline.run(pool[s][i % 4], lens, {});
+            const cv::Mat out = pipeline.run(pool[s][i % 4], lens, quality);
             if (out.size() != sizes[s]) {
                 std::fprintf(stderr, "defocus-soak: frame %zu came out %dx%d\n", i, out.cols, out.rows);
                 return 1;
@@ -85,20 +98,23 @@ int main(int argc, char** argv)
         }
         // Back on the size the warm-up ended on, so the same targets exist.
         const int lastSize = static_cast<int>(((warmup - 1) / 50) % 2);
-        pipeline.run(pool[lastSize][0], lens, {});
+        pipeline.run(pool[lastSize][0], lens, quality);
         const double rssEnd = residentMiB();
         const long objectsEnd = gl::liveObjects.load();
-        std::printf("defocus-soak: %zu frames (%dx%d and %dx%d), RSS %.1f -> %.1f MiB after %zu warm-up frames, "
-                    "GL objects %ld -> %ld\n",
-                    frames, sizes[0].width, sizes[0].height, sizes[1].width, sizes[1].height, rssStart, rssEnd, warmup,
+        std::printf("defocus-soak: %zu frames (%dx%d and %dx%d, --quality %s), RSS %.1f -> %.1f MiB after %zu warm-up "
+                    "frames, GL objects %ld -> %ld\n",
+                    frames, sizes[0].width, sizes[0].height, sizes[1].width, sizes[1].height, qualityName.c_str(), rssStart, rssEnd, warmup,
                     objectsStart, objectsEnd);
         if (rssEnd - rssStart > maxGrowthMiB || objectsEnd != objectsStart) {
             std::fprintf(stderr, "defocus-soak: memory or GL objects grew\n");
             return 1;
         }
         return 0;
+    } catch (const gl::ContextError& error) {
+        std::fprintf(stderr, "defocus-soak: %s\n", error.what());
+        return kExitUnavailable;
     } catch (const std::exception& error) {
         std::fprintf(stderr, "defocus-soak: %s\n", error.what());
-        return 1;
+        return kExitBadInput;
     }
 }
