@@ -75,18 +75,7 @@ TEST_P(PipelineTum, RecordedClipEndToEnd)
             for (int y = 0; y < depth.rows; ++y)
                 for (int x = 0; x < depth.cols; ++x)
                     signedCoc.at<float>(y, x) = cocPixels(k, depth.at<float>(y, x));
-            const int largest = static_cast<int>(std::ceil(lens.maxCocPx / 2.0));
-            for (int radius = 1; radius <= largest; ++radius) {
-                // Near pixels whose blur radius rounds up to `radius`, grown by it (+ 3 px).
-                const cv::Mat near = (signedCoc <= -2.0f * static_cast<float>(radius - 1) - 0.5f) &
-                                     (signedCoc > -2.0f * static_cast<float>(radius) - 0.5f);
-                if (cv::countNonZero(near) == 0)
-                    continue;
-                const int r = radius + 3;
-                cv::Mat reach;
-                cv::dilate(near, reach, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
-                sharp.setTo(0, reach);
-            }
+            sharp.setTo(0, test::foregroundReach(signedCoc, 3));
         }
         ASSERT_GT(cv::countNonZero(sharp), 1000) << frame->name << ": focus 1 m must have pixels in focus";
         double worst = 0;

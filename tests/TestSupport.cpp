@@ -2,6 +2,7 @@
 #include "tests/TestSupport.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -9,6 +10,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "filter/methods/Presets.hpp"
 
@@ -76,6 +78,26 @@ std::vector<NamedQuality> presetsAndKernels()
     mcintosh.kernel = HexagonKernel::McIntoshMin;
     list.push_back({"mcintosh", mcintosh});
     return list;
+}
+
+cv::Mat foregroundReach(const cv::Mat& signedCoc, int margin)
+{
+    CV_Assert(signedCoc.type() == CV_32F);
+    cv::Mat reach = cv::Mat::zeros(signedCoc.size(), CV_8U);
+    double lowest = 0.0;
+    cv::minMaxLoc(signedCoc, &lowest);
+    // Near pixels by their radius rounded up, each group grown by that radius and the margin.
+    for (int radius = 1; radius <= static_cast<int>(std::ceil(-lowest / 2.0)); ++radius) {
+        const cv::Mat near = (signedCoc <= -0.5f) & (signedCoc > -2.0f * static_cast<float>(radius)) &
+                             (signedCoc <= -2.0f * static_cast<float>(radius - 1));
+        if (cv::countNonZero(near) == 0)
+            continue;
+        const int r = radius + margin;
+        cv::Mat grown;
+        cv::dilate(near, grown, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
+        reach |= grown;
+    }
+    return reach;
 }
 
 bool allFinite(const cv::Mat& m)

@@ -40,6 +40,10 @@ std::vector<NamedQuality> shippedPresets();
 /// 16F, full size, no near field): "rhombi" and "mcintosh", the published chain, which no
 /// preset uses.
 std::vector<NamedQuality> presetsAndKernels();
+/// Where the near field may spread blurred foreground (CV_8U, 255 there): every pixel within
+/// |CoC| / 2 + `margin` px of a pixel whose signed CoC (`signedCoc`, CV_32F, pixels) is -0.5 or
+/// less. Pixels in focus there may take a share of the foreground, by design.
+cv::Mat foregroundReach(const cv::Mat& signedCoc, int margin);
 /// True when every element of `m` (any depth, any channels) is finite.
 bool allFinite(const cv::Mat& m);
 
