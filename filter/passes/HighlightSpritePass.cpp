@@ -1,6 +1,7 @@
 // Bokeh sprites: one compute dispatch appends the sprites and counts them into the indirect draw
 // command in the same buffer, a second of one invocation empties the draw of a frame over its
-// budget; one instanced draw of hexagons adds them, blended, to the output.
+// budget, the CPU puts them in the order of their pixels; one instanced draw of hexagons adds
+// them, blended, to the output.
 #include "filter/passes/HighlightSpritePass.hpp"
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <vector>
 
 #include "filter/passes/CocPass.hpp"
 #include "filter/passes/Pass.hpp"
@@ -88,7 +90,25 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     settle_.use();
     glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+
+    // The search appends sprites in whatever order its invocations run, and the draw adds them
+    // in that order: where sprites overlap, float sums (and an sRGB8 target's rounding after each
+    // one) then differed from run to run by an 8-bit step. In the order of their pixels the same
+    // frame gives the same bits every time (AdaptivePlanGLTest). Each sprite is one texel, so
+    // its position orders it.
+    std::array<std::uint32_t, 8> read{};
+    glGetNamedBufferSubData(sprites_.id(), 0, static_cast<GLsizeiptr>(sizeof read), read.data());
+    const std::size_t count = read[1] / 4; // four instances per sprite
+    if (count > 1) {
+        std::vector<std::array<float, 8>> list(count);
+        const auto bytes = static_cast<GLsizeiptr>(count * kSpriteBytes);
+        glGetNamedBufferSubData(sprites_.id(), static_cast<GLintptr>(kHeaderBytes), bytes, list.data());
+        std::sort(list.begin(), list.end(), [](const std::array<float, 8>& a, const std::array<float, 8>& b) {
+            return a[1] < b[1] || (a[1] == b[1] && a[0] < b[0]);
+        });
+        glNamedBufferSubData(sprites_.id(), static_cast<GLintptr>(kHeaderBytes), bytes, list.data());
+    }
 }
 
 void HighlightSpritePass::draw(const gl::Texture& depth, const gl::Framebuffer& target)
