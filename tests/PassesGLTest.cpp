@@ -1,5 +1,7 @@
-// The McIntosh passes checked analytically on llvmpipe: zero CoC is the identity, a point light
-// becomes a hexagon of the predicted size and orientation, constant depth blurs uniformly.
+// The passes checked analytically on llvmpipe, on both kernels and (where a test is not about one
+// pass) every preset: zero CoC is the identity, a point light becomes a hexagon of the predicted
+// size and orientation, constant depth blurs uniformly, HDR light keeps its energy, near and far
+// blur meeting do not cancel, and each view shows what it names.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
