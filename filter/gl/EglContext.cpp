@@ -196,4 +196,14 @@ void EglContext::makeCurrent() const
     eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, state_->context);
 }
 
+bool EglContext::isCurrent() const
+{
+    return eglGetCurrentContext() == state_->context;
+}
+
+void EglContext::release() const
+{
+    eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+}
+
 } // namespace defocus::gl
