@@ -486,7 +486,8 @@ cv::Mat toFilter(GstVideoFrame* color)
 /// The filter's BGR result into `frame`, in its format; alpha (or x) is opaque.
 void fromFilter(const cv::Mat& bgr, GstVideoFrame* frame)
 {
-    cv::Mat out = wrap(frame, GST_VIDEO_FRAME_N_COMPONENTS(frame) == 4 ? CV_8UC4 : CV_8UC3);
+    // BGRx has three components but four bytes a pixel.
+    cv::Mat out = wrap(frame, GST_VIDEO_FRAME_COMP_PSTRIDE(frame, 0) == 4 ? CV_8UC4 : CV_8UC3);
     switch (GST_VIDEO_FRAME_FORMAT(frame)) {
     case GST_VIDEO_FORMAT_BGRx:
     case GST_VIDEO_FORMAT_BGRA: cv::cvtColor(bgr, out, cv::COLOR_BGR2BGRA); break;
