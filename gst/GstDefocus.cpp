@@ -347,7 +347,9 @@ void pads(GstDefocus* self, GstVideoAggregatorPad*& color, GstVideoAggregatorPad
 // output is.
 gboolean sinkQuery(GstAggregator* agg, GstAggregatorPad* pad, GstQuery* query)
 {
+    GST_OBJECT_LOCK(agg);
     const bool depth = GST_VIDEO_AGGREGATOR_PAD(pad) == stateOf(agg).depth;
+    GST_OBJECT_UNLOCK(agg);
     if (depth && GST_QUERY_TYPE(query) == GST_QUERY_CAPS) {
         GstCaps* filter = nullptr;
         gst_query_parse_caps(query, &filter);
