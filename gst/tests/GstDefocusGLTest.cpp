@@ -419,6 +419,43 @@ TEST_F(GstDefocus, NoDepthStreamIsAClearError)
     EXPECT_NE(e.error().find("No depth stream"), std::string::npos);
 }
 
+// Defect caught: a live pipeline that stalls (the element waiting for data a live source gives
+// only in time), or that reports no latency of its own, so that a live sink drops every frame.
+TEST_F(GstDefocus, LiveSourcesFlowAndLatencyIsReported)
+{
+    GError* error = nullptr;
+    GstElement* pipeline = gst_parse_launch(
+        "defocus name=d autofocus=false focus=1.0 post-timings=true ! fakesink sync=true "
+        "videotestsrc is-live=true ! video/x-raw,format=BGR,width=160,height=120,framerate=30/1 ! d.color "
+        "videotestsrc is-live=true pattern=solid-color foreground-color=0xff404040 "
+        "! video/x-raw,format=GRAY16_LE,width=160,height=120,framerate=30/1 ! d.depth",
+        &error);
+    ASSERT_EQ(error, nullptr) << error->message;
+    GstBus* bus = gst_element_get_bus(pipeline);
+    ASSERT_NE(gst_element_set_state(pipeline, GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);
+    int frames = 0;
+    while (frames < 10) {
+        GstMessage* message =
+            gst_bus_timed_pop_filtered(bus, 10 * GST_SECOND, static_cast<GstMessageType>(GST_MESSAGE_ELEMENT | GST_MESSAGE_ERROR));
+        ASSERT_NE(message, nullptr) << "no frame for 10 s after " << frames;
+        ASSERT_NE(GST_MESSAGE_TYPE(message), GST_MESSAGE_ERROR);
+        frames += gst_structure_has_name(gst_message_get_structure(message), "defocus-timings") ? 1 : 0;
+        gst_message_unref(message);
+    }
+    GstQuery* query = gst_query_new_latency();
+    ASSERT_TRUE(gst_element_query(pipeline, query));
+    gboolean live = FALSE;
+    GstClockTime min = 0, max = 0;
+    gst_query_parse_latency(query, &live, &min, &max);
+    EXPECT_TRUE(live);
+    // videotestsrc's own frame, and the element's (one output frame to filter in).
+    EXPECT_GE(min, 2 * kFrame);
+    gst_query_unref(query);
+    gst_element_set_state(pipeline, GST_STATE_NULL);
+    gst_object_unref(bus);
+    gst_object_unref(pipeline);
+}
+
 } // namespace
 
 int main(int argc, char** argv)
