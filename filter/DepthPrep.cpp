@@ -2,9 +2,11 @@
 #include "filter/DepthPrep.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
 namespace defocus {
@@ -116,6 +118,22 @@ float centreDepth(const cv::Mat& depth, double windowFraction, float fallbackM)
     auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
     std::nth_element(values.begin(), middle, values.end());
     return *middle;
+}
+
+std::string depthFitProblem(const cv::Size& colorSize, const std::string& colorName, const cv::Size& depthSize,
+                            const std::string& depthName)
+{
+    if (depthSize == colorSize || colorSize.empty() || depthSize.empty())
+        return {};
+    const double expectedHeight = static_cast<double>(depthSize.width) * colorSize.height / colorSize.width;
+    if (std::abs(depthSize.height - expectedHeight) <= std::max(1.0, 0.01 * depthSize.height))
+        return {};
+    return fmt::format(
+        "depth '{}' is {}x{} but colour '{}' is {}x{}: their aspect ratios ({:.3f} and {:.3f}) differ; "
+        "depth of another size is scaled to the colour, so it must have the same aspect ratio",
+        depthName, depthSize.width, depthSize.height, colorName, colorSize.width, colorSize.height,
+        static_cast<double>(depthSize.width) / depthSize.height,
+        static_cast<double>(colorSize.width) / colorSize.height);
 }
 
 } // namespace defocus

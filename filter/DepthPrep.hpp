@@ -2,6 +2,7 @@
 #pragma once
 
 #include <limits>
+#include <string>
 
 #include <opencv2/core.hpp>
 
@@ -25,6 +26,13 @@ struct PreparedDepth {
 /// averages of the valid neighbours, coarse levels filling what finer ones cannot. A frame with
 /// no valid depth at all (or no depth) becomes `fallbackM` everywhere.
 PreparedDepth prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM);
+
+/// Depth of another size is resized to the colour, but only at the same aspect ratio: they agree
+/// when the depth height is within one pixel (or 1 %) of depth width * colour height / colour
+/// width. Returns "" when `depthSize` fits `colorSize`, otherwise one line naming both images
+/// (`depthName`, `colorName`) and both sizes.
+std::string depthFitProblem(const cv::Size& colorSize, const std::string& colorName, const cv::Size& depthSize,
+                            const std::string& depthName);
 
 /// Robust depth of the centre of the frame: the median of valid depths in the central
 /// `windowFraction` of each axis; `fallbackM` when that window has no valid depth.

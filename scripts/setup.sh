@@ -19,6 +19,9 @@ packages=(
   nlohmann-json3-dev       # JSON timings and benchmark output
   libgtest-dev libgmock-dev googletest   # tests
   libbenchmark-dev         # micro-benchmarks
+  libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev   # the GStreamer element (gst/)
+  gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good   # its tests: gst-launch-1.0, pngdec, imagefreeze
+  gstreamer1.0-plugins-ugly gstreamer1.0-libav gstreamer1.0-x   # README pipelines: x264enc, H.264 decoding, ximagesink
 )
 
 missing=()

@@ -18,6 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "filter/DepthPrep.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/ImageHeader.hpp"
 
@@ -242,17 +243,8 @@ cv::Mat readDepth(const fs::path& file, double unitsPerMetre)
 void checkDepthFits(const cv::Size& colorSize, const std::string& colorName, const cv::Size& depthSize,
                     const std::string& depthName)
 {
-    if (depthSize == colorSize || colorSize.empty() || depthSize.empty())
-        return;
-    const double expectedHeight = static_cast<double>(depthSize.width) * colorSize.height / colorSize.width;
-    if (std::abs(depthSize.height - expectedHeight) <= std::max(1.0, 0.01 * depthSize.height))
-        return;
-    throw SourceError(fmt::format(
-        "depth '{}' is {}x{} but colour '{}' is {}x{}: their aspect ratios ({:.3f} and {:.3f}) differ; "
-        "depth of another size is scaled to the colour, so it must have the same aspect ratio",
-        depthName, depthSize.width, depthSize.height, colorName, colorSize.width, colorSize.height,
-        static_cast<double>(depthSize.width) / depthSize.height,
-        static_cast<double>(colorSize.width) / colorSize.height));
+    if (const std::string problem = depthFitProblem(colorSize, colorName, depthSize, depthName); !problem.empty())
+        throw SourceError(problem);
 }
 
 } // namespace defocus

@@ -1,6 +1,8 @@
 // EGL device platform first, Mesa surfaceless next; OpenGL 4.5 core; no surface at all.
 #include "filter/gl/EglContext.hpp"
 
+#include <map>
+#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -11,6 +13,33 @@
 
 namespace defocus::gl {
 
+namespace {
+
+// An EGL display is one per device in a process, and eglTerminate() ends every context on it:
+// contexts count their display's users, and the last one terminates it, so that one context's
+// end does not pull the display from under another (two filters, or a filter and a renderer).
+std::mutex gDisplayUsersLock;
+std::map<EGLDisplay, int> gDisplayUsers;
+
+void retainDisplay(EGLDisplay display)
+{
+    const std::lock_guard guard(gDisplayUsersLock);
+    ++gDisplayUsers[display];
+}
+
+/// True when the caller was the display's last user.
+bool releaseDisplay(EGLDisplay display)
+{
+    const std::lock_guard guard(gDisplayUsersLock);
+    const auto found = gDisplayUsers.find(display);
+    if (found == gDisplayUsers.end() || --found->second > 0)
+        return false;
+    gDisplayUsers.erase(found);
+    return true;
+}
+
+} // namespace
+
 struct EglContext::State {
     EGLDisplay display = EGL_NO_DISPLAY;
     EGLContext context = EGL_NO_CONTEXT;
@@ -19,10 +48,13 @@ struct EglContext::State {
     {
         if (display == EGL_NO_DISPLAY)
             return;
-        eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        // Another context current on this thread stays current.
+        if (context != EGL_NO_CONTEXT && eglGetCurrentContext() == context)
+            eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         if (context != EGL_NO_CONTEXT)
             eglDestroyContext(display, context);
-        eglTerminate(display);
+        if (releaseDisplay(display))
+            eglTerminate(display);
     }
 };
 
@@ -79,6 +111,7 @@ std::string tryDisplay(EGLDisplay display, EglContext::State& state, bool debug)
     EGLint major = 0, minor = 0;
     if (eglInitialize(display, &major, &minor) != EGL_TRUE)
         return "eglInitialize failed: " + eglErrorName(eglGetError());
+    retainDisplay(display);
     state.display = display;
     if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE)
         return "no desktop OpenGL API: " + eglErrorName(eglGetError());
@@ -194,6 +227,16 @@ EglContext::~EglContext() = default;
 void EglContext::makeCurrent() const
 {
     eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, state_->context);
+}
+
+bool EglContext::isCurrent() const
+{
+    return eglGetCurrentContext() == state_->context;
+}
+
+void EglContext::release() const
+{
+    eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
 }
 
 } // namespace defocus::gl

@@ -40,6 +40,11 @@ public:
     const ContextInfo& info() const { return info_; }
     /// Makes the context current on the calling thread.
     void makeCurrent() const;
+    /// True when this context is current on the calling thread.
+    bool isCurrent() const;
+    /// Unbinds whatever context is current on the calling thread, so that another thread can
+    /// make this one current.
+    void release() const;
 
     struct State; ///< display + context, defined in the .cpp
 

@@ -1,0 +1,793 @@
+// The GStreamer element `defocus`: colour on the `color` pad, depth on the `depth` pad, paired by
+// running time (GstVideoAggregator), the depth of field of a lens out of `src`. It uses only
+// libdefocus' public API, on an EGL context of its own made on the streaming thread.
+//   gst-launch-1.0 defocus name=d focus=1.2 f-number=1.4 ! videoconvert ! autovideosink
+//     filesrc location=clip.mp4 ! decodebin ! videoconvert ! d.color
+//     filesrc location=depth.png ! pngdec ! imagefreeze ! d.depth         (one line)
+#include "gst/GstDefocus.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+
+#include <defocus/defocus.hpp>
+#include <opencv2/imgproc.hpp>
+
+GST_DEBUG_CATEGORY_STATIC(gst_defocus_debug);
+#define GST_CAT_DEFAULT gst_defocus_debug
+
+namespace {
+
+/// What the element keeps besides the GObject: settings written by any thread (under `lock`),
+/// the filter and its bookkeeping used by the streaming thread only.
+struct State {
+    std::mutex lock;
+    defocus::Settings settings;     ///< as the properties say
+    bool nearFieldSet = false;      ///< near-field was set: it overrides the quality preset
+    bool postTimings = false;
+    unsigned generation = 1;        ///< bumped by every property change
+    GstVideoAggregatorPad* color = nullptr; ///< the request pads, or null (under the object lock)
+    GstVideoAggregatorPad* depth = nullptr;
+
+    // Streaming thread only.
+    std::unique_ptr<defocus::Filter> filter;
+    unsigned applied = 0;           ///< generation the filter has
+    std::set<std::string> warned;   ///< settings problems already posted as warnings
+    std::atomic<bool> resetPending{false}; ///< a flush happened: the next frame starts a new stream
+};
+
+} // namespace
+
+struct _GstDefocus {
+    GstVideoAggregator parent;
+    State* state;
+};
+
+G_DEFINE_TYPE(GstDefocus, gst_defocus, GST_TYPE_VIDEO_AGGREGATOR)
+
+namespace {
+
+enum Property {
+    PROP_0,
+    PROP_FOCUS,
+    PROP_AUTOFOCUS,
+    PROP_AUTOFOCUS_TIME_CONSTANT,
+    PROP_F_NUMBER,
+    PROP_FOCAL_LENGTH,
+    PROP_SENSOR_WIDTH,
+    PROP_FOV_FROM,
+    PROP_MAX_COC,
+    PROP_COC_MODEL,
+    PROP_NEAR,
+    PROP_FAR,
+    PROP_QUALITY,
+    PROP_SAMPLES,
+    PROP_HEXAGON,
+    PROP_PRECISION,
+    PROP_RESOLUTION,
+    PROP_NEAR_FIELD,
+    PROP_HIGHLIGHT_SPRITES,
+    PROP_HIGHLIGHT_GAIN,
+    PROP_BLADE_ROTATION,
+    PROP_DEPTH_SCALE,
+    PROP_VIEW,
+    PROP_POST_TIMINGS,
+};
+
+// Enums: the value nicks are the command line's words. "from-quality" leaves the choice to the
+// quality preset, as leaving out the flag does.
+GType registerEnum(const char* name, const GEnumValue* values)
+{
+    const GType type = g_enum_register_static(name, values);
+    gst_type_mark_as_plugin_api(type, static_cast<GstPluginAPIFlags>(0));
+    return type;
+}
+
+GType fovFromType()
+{
+    static const GEnumValue values[] = {
+        {0, "A real camera: its view narrows as it focuses closer", "image-distance"},
+        {1, "Renderers (Blender Cycles, game engines)", "focal-length"},
+        {0, nullptr, nullptr}};
+    static const GType type = registerEnum("GstDefocusFovFrom", values);
+    return type;
+}
+
+GType cocModelType()
+{
+    static const GEnumValue values[] = {{0, "Physical thin lens", "thin-lens"},
+                                        {1, "Blur rises linearly from focus to max-coc at near and far", "focal-range"},
+                                        {0, nullptr, nullptr}};
+    static const GType type = registerEnum("GstDefocusCocModel", values);
+    return type;
+}
+
+GType qualityType()
+{
+    static const GEnumValue values[] = {{0, "4 taps, half size", "fast"},
+                                        {1, "6 taps, half size", "balanced"},
+                                        {2, "12 taps, full size", "high"},
+                                        {0, nullptr, nullptr}};
+    static const GType type = registerEnum("GstDefocusQuality", values);
+    return type;
+}
+
+GType hexagonType()
+{
+    static const GEnumValue values[] = {{0, "The quality preset's", "from-quality"},
+                                        {1, "Three one-sided rhombi summed (keeps highlight energy)", "rhombi"},
+                                        {2, "McIntosh et al. 2012, min of two", "mcintosh"},
+                                        {0, nullptr, nullptr}};
+    static const GType type = registerEnum("GstDefocusHexagon", values);
+    return type;
+}
+
+GType precisionType()
+{
+    static const GEnumValue values[] = {{0, "The quality preset's", "from-quality"},
+                                        {1, "16-bit float targets", "16f"},
+                                        {2, "32-bit float targets", "32f"},
+                                        {0, nullptr, nullptr}};
+    static const GType type = registerEnum("GstDefocusPrecision", values);
+    return type;
+}
+
+GType resolutionType()
+{
+    static const GEnumValue values[] = {{0, "The quality preset's", "from-quality"},
+                                        {1, "Blurs at the frame's size", "full"},
+                                        {2, "Blurs at half size (a quarter of the pixels)", "half"},
+                                        {0, nullptr, nullptr}};
+    static const GType type = registerEnum("GstDefocusResolution", values);
+    return type;
+}
+
+GType viewType()
+{
+    static const GEnumValue values[] = {{0, "The colour the blur starts from", "input"},
+                                        {1, "After the first blur pass", "horizontal"},
+                                        {2, "Second pass, first diagonal", "diagonal-a"},
+                                        {3, "Second pass, second diagonal", "diagonal-b"},
+                                        {4, "The depth-of-field result", "composite"},
+                                        {5, "Filled depth, colour-mapped, with a legend", "depth"},
+                                        {6, "Signed blur diameter, colour-mapped, with a legend", "coc"},
+                                        {0, nullptr, nullptr}};
+    static const GType type = registerEnum("GstDefocusView", values);
+    return type;
+}
+
+constexpr GParamFlags kFlags = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                        GST_PARAM_MUTABLE_PLAYING);
+constexpr GParamFlags kControllable = static_cast<GParamFlags>(kFlags | GST_PARAM_CONTROLLABLE);
+
+// Output formats: 8-bit RGB in the orders downstream elements ask for; the colour pad converts
+// anything else (I420, NV12, YUY2, ...) to the one negotiated.
+#define DEFOCUS_RGB_FORMATS "{ BGRx, BGRA, RGBx, RGBA, BGR, RGB }"
+#define DEFOCUS_COLOR_FORMATS                                                                                       \
+    "{ BGRx, BGRA, RGBx, RGBA, xRGB, xBGR, ARGB, ABGR, BGR, RGB, I420, YV12, NV12, NV21, YUY2, UYVY, Y42B, Y444, " \
+    "GRAY8 }"
+
+GstStaticPadTemplate srcTemplate = GST_STATIC_PAD_TEMPLATE(
+    "src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(DEFOCUS_RGB_FORMATS)));
+GstStaticPadTemplate colorTemplate = GST_STATIC_PAD_TEMPLATE(
+    "color", GST_PAD_SINK, GST_PAD_REQUEST, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(DEFOCUS_COLOR_FORMATS)));
+// 16-bit depth in depth-scale units per metre; PNG decoders give big-endian.
+GstStaticPadTemplate depthTemplate = GST_STATIC_PAD_TEMPLATE(
+    "depth", GST_PAD_SINK, GST_PAD_REQUEST, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE("{ GRAY16_LE, GRAY16_BE }")));
+
+State& stateOf(gpointer self)
+{
+    return *GST_DEFOCUS(self)->state;
+}
+
+void setProperty(GObject* object, guint id, const GValue* value, GParamSpec* pspec)
+{
+    State& s = stateOf(object);
+    bool autofocusOff = false;
+    {
+        std::lock_guard guard(s.lock);
+        defocus::Settings& st = s.settings;
+        switch (id) {
+        case PROP_FOCUS:
+            st.lens.focusM = g_value_get_double(value);
+            // A focus set by hand (or by a control source) is manual focus.
+            autofocusOff = st.autofocus.mode != defocus::AutofocusOptions::Mode::Off;
+            st.autofocus.mode = defocus::AutofocusOptions::Mode::Off;
+            break;
+        case PROP_AUTOFOCUS:
+            st.autofocus.mode = g_value_get_boolean(value) ? defocus::AutofocusOptions::Mode::Follow
+                                                           : defocus::AutofocusOptions::Mode::Off;
+            break;
+        case PROP_AUTOFOCUS_TIME_CONSTANT: st.autofocus.timeConstantS = g_value_get_double(value); break;
+        case PROP_F_NUMBER: st.lens.fNumber = g_value_get_double(value); break;
+        case PROP_FOCAL_LENGTH: st.lens.focalLengthMm = g_value_get_double(value); break;
+        case PROP_SENSOR_WIDTH: st.lens.sensorWidthMm = g_value_get_double(value); break;
+        case PROP_FOV_FROM: st.lens.fovFrom = static_cast<defocus::Lens::FovFrom>(g_value_get_enum(value)); break;
+        case PROP_MAX_COC: st.lens.maxCocPx = g_value_get_double(value); break;
+        case PROP_COC_MODEL: st.lens.cocModel = static_cast<defocus::Lens::Model>(g_value_get_enum(value)); break;
+        case PROP_NEAR: st.lens.nearM = g_value_get_double(value); break;
+        case PROP_FAR: st.lens.farM = g_value_get_double(value); break;
+        case PROP_QUALITY: st.quality.preset = static_cast<defocus::Quality::Preset>(g_value_get_enum(value)); break;
+        case PROP_SAMPLES: {
+            const int samples = g_value_get_int(value);
+            st.quality.samples = samples == 0 ? std::nullopt : std::optional<int>(samples);
+            break;
+        }
+        case PROP_HEXAGON: {
+            const int v = g_value_get_enum(value);
+            st.quality.hexagon = v == 0 ? std::nullopt
+                                        : std::optional(v == 1 ? defocus::Quality::Hexagon::Rhombi
+                                                               : defocus::Quality::Hexagon::McIntosh);
+            break;
+        }
+        case PROP_PRECISION: {
+            const int v = g_value_get_enum(value);
+            st.quality.precision = v == 0 ? std::nullopt
+                                          : std::optional(v == 1 ? defocus::Quality::Precision::F16
+                                                                 : defocus::Quality::Precision::F32);
+            break;
+        }
+        case PROP_RESOLUTION: {
+            const int v = g_value_get_enum(value);
+            st.quality.resolution = v == 0 ? std::nullopt
+                                           : std::optional(v == 1 ? defocus::Quality::Resolution::Full
+                                                                  : defocus::Quality::Resolution::Half);
+            break;
+        }
+        case PROP_NEAR_FIELD:
+            st.quality.nearField = g_value_get_boolean(value) != FALSE;
+            s.nearFieldSet = true;
+            break;
+        case PROP_HIGHLIGHT_SPRITES: st.quality.highlightSprites = g_value_get_boolean(value) != FALSE; break;
+        case PROP_HIGHLIGHT_GAIN: st.quality.highlightGain = g_value_get_double(value); break;
+        case PROP_BLADE_ROTATION: st.lens.bladeRotationDeg = g_value_get_double(value); break;
+        case PROP_DEPTH_SCALE: st.depthScale = g_value_get_double(value); break;
+        case PROP_VIEW: st.view = static_cast<defocus::Settings::View>(g_value_get_enum(value)); break;
+        case PROP_POST_TIMINGS: s.postTimings = g_value_get_boolean(value) != FALSE; break;
+        default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); return;
+        }
+        ++s.generation;
+    }
+    if (autofocusOff)
+        g_object_notify(object, "autofocus");
+}
+
+void getProperty(GObject* object, guint id, GValue* value, GParamSpec* pspec)
+{
+    State& s = stateOf(object);
+    std::lock_guard guard(s.lock);
+    const defocus::Settings& st = s.settings;
+    switch (id) {
+    case PROP_FOCUS: g_value_set_double(value, st.lens.focusM); break;
+    case PROP_AUTOFOCUS: g_value_set_boolean(value, st.autofocus.mode != defocus::AutofocusOptions::Mode::Off); break;
+    case PROP_AUTOFOCUS_TIME_CONSTANT: g_value_set_double(value, st.autofocus.timeConstantS); break;
+    case PROP_F_NUMBER: g_value_set_double(value, st.lens.fNumber); break;
+    case PROP_FOCAL_LENGTH: g_value_set_double(value, st.lens.focalLengthMm); break;
+    case PROP_SENSOR_WIDTH: g_value_set_double(value, st.lens.sensorWidthMm); break;
+    case PROP_FOV_FROM: g_value_set_enum(value, static_cast<int>(st.lens.fovFrom)); break;
+    case PROP_MAX_COC: g_value_set_double(value, st.lens.maxCocPx); break;
+    case PROP_COC_MODEL: g_value_set_enum(value, static_cast<int>(st.lens.cocModel)); break;
+    case PROP_NEAR: g_value_set_double(value, st.lens.nearM); break;
+    case PROP_FAR: g_value_set_double(value, st.lens.farM); break;
+    case PROP_QUALITY: g_value_set_enum(value, static_cast<int>(st.quality.preset)); break;
+    case PROP_SAMPLES: g_value_set_int(value, st.quality.samples.value_or(0)); break;
+    case PROP_HEXAGON:
+        g_value_set_enum(value, !st.quality.hexagon ? 0 : *st.quality.hexagon == defocus::Quality::Hexagon::Rhombi ? 1 : 2);
+        break;
+    case PROP_PRECISION:
+        g_value_set_enum(value,
+                         !st.quality.precision ? 0 : *st.quality.precision == defocus::Quality::Precision::F16 ? 1 : 2);
+        break;
+    case PROP_RESOLUTION:
+        g_value_set_enum(value, !st.quality.resolution                                       ? 0
+                                : *st.quality.resolution == defocus::Quality::Resolution::Full ? 1
+                                                                                               : 2);
+        break;
+    case PROP_NEAR_FIELD: g_value_set_boolean(value, st.quality.nearField.value_or(true)); break;
+    case PROP_HIGHLIGHT_SPRITES: g_value_set_boolean(value, st.quality.highlightSprites); break;
+    case PROP_HIGHLIGHT_GAIN: g_value_set_double(value, st.quality.highlightGain); break;
+    case PROP_BLADE_ROTATION: g_value_set_double(value, st.lens.bladeRotationDeg); break;
+    case PROP_DEPTH_SCALE: g_value_set_double(value, st.depthScale); break;
+    case PROP_VIEW: g_value_set_enum(value, static_cast<int>(st.view)); break;
+    case PROP_POST_TIMINGS: g_value_set_boolean(value, s.postTimings); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    }
+}
+
+// ---- pads ----------------------------------------------------------------------------------------
+
+GstAggregatorPad* createNewPad(GstAggregator* agg, GstPadTemplate* templ, const gchar*, const GstCaps*)
+{
+    State& s = stateOf(agg);
+    const bool isColor = g_strcmp0(GST_PAD_TEMPLATE_NAME_TEMPLATE(templ), "color") == 0;
+    GST_OBJECT_LOCK(agg);
+    GstVideoAggregatorPad*& slot = isColor ? s.color : s.depth;
+    if (slot) {
+        GST_OBJECT_UNLOCK(agg);
+        GST_WARNING_OBJECT(agg, "the %s pad exists already; there is one of each", isColor ? "color" : "depth");
+        return nullptr;
+    }
+    const GType type = isColor ? GST_TYPE_VIDEO_AGGREGATOR_CONVERT_PAD : GST_TYPE_VIDEO_AGGREGATOR_PAD;
+    auto* pad = GST_VIDEO_AGGREGATOR_PAD(g_object_new(type, "name", isColor ? "color" : "depth", "direction",
+                                                      GST_PAD_SINK, "template", templ, nullptr));
+    slot = pad;
+    GST_OBJECT_UNLOCK(agg);
+    // A depth stream that ends (one still image) keeps its last frame for the rest of the colour.
+    if (!isColor)
+        g_object_set(pad, "repeat-after-eos", TRUE, nullptr);
+    return GST_AGGREGATOR_PAD(pad);
+}
+
+void releasePad(GstElement* element, GstPad* pad)
+{
+    State& s = stateOf(element);
+    GST_OBJECT_LOCK(element);
+    if (GST_VIDEO_AGGREGATOR_PAD(pad) == s.color)
+        s.color = nullptr;
+    if (GST_VIDEO_AGGREGATOR_PAD(pad) == s.depth)
+        s.depth = nullptr;
+    GST_OBJECT_UNLOCK(element);
+    GST_ELEMENT_CLASS(gst_defocus_parent_class)->release_pad(element, pad);
+}
+
+/// The colour and depth pads, referenced (either may be null).
+void pads(GstDefocus* self, GstVideoAggregatorPad*& color, GstVideoAggregatorPad*& depth)
+{
+    State& s = *self->state;
+    GST_OBJECT_LOCK(self);
+    color = s.color ? GST_VIDEO_AGGREGATOR_PAD(gst_object_ref(s.color)) : nullptr;
+    depth = s.depth ? GST_VIDEO_AGGREGATOR_PAD(gst_object_ref(s.depth)) : nullptr;
+    GST_OBJECT_UNLOCK(self);
+}
+
+// The base class offers a pad the output's caps; depth has caps of its own (GRAY16), whatever the
+// output is.
+gboolean sinkQuery(GstAggregator* agg, GstAggregatorPad* pad, GstQuery* query)
+{
+    GST_OBJECT_LOCK(agg);
+    const bool depth = GST_VIDEO_AGGREGATOR_PAD(pad) == stateOf(agg).depth;
+    GST_OBJECT_UNLOCK(agg);
+    if (depth && GST_QUERY_TYPE(query) == GST_QUERY_CAPS) {
+        GstCaps* filter = nullptr;
+        gst_query_parse_caps(query, &filter);
+        GstCaps* caps = gst_pad_get_pad_template_caps(GST_PAD(pad));
+        if (filter) {
+            GstCaps* both = gst_caps_intersect_full(filter, caps, GST_CAPS_INTERSECT_FIRST);
+            gst_caps_unref(caps);
+            caps = both;
+        }
+        gst_query_set_caps_result(query, caps);
+        gst_caps_unref(caps);
+        return TRUE;
+    }
+    if (depth && GST_QUERY_TYPE(query) == GST_QUERY_ACCEPT_CAPS) {
+        GstCaps* caps = nullptr;
+        gst_query_parse_accept_caps(query, &caps);
+        GstCaps* templ = gst_pad_get_pad_template_caps(GST_PAD(pad));
+        gst_query_set_accept_caps_result(query, gst_caps_is_subset(caps, templ));
+        gst_caps_unref(templ);
+        return TRUE;
+    }
+    return GST_AGGREGATOR_CLASS(gst_defocus_parent_class)->sink_query(agg, pad, query);
+}
+
+// ---- caps ----------------------------------------------------------------------------------------
+
+/// The output has the colour's size, frame rate and pixel aspect; its format is the colour's
+/// when that is one of the output formats, else what downstream prefers of them.
+GstFlowReturn updateSrcCaps(GstAggregator* agg, GstCaps* downstream, GstCaps** result)
+{
+    auto* self = GST_DEFOCUS(agg);
+    GstVideoAggregatorPad *color = nullptr, *depth = nullptr;
+    pads(self, color, depth);
+    if (depth)
+        gst_object_unref(depth);
+    if (!color)
+        return GST_AGGREGATOR_FLOW_NEED_DATA;
+    GST_OBJECT_LOCK(self);
+    const GstVideoInfo info = color->info;
+    GST_OBJECT_UNLOCK(self);
+    gst_object_unref(color);
+    if (!info.finfo || GST_VIDEO_INFO_FORMAT(&info) == GST_VIDEO_FORMAT_UNKNOWN)
+        return GST_AGGREGATOR_FLOW_NEED_DATA;
+
+    GstCaps* shape = gst_caps_new_simple("video/x-raw", "width", G_TYPE_INT, info.width, "height", G_TYPE_INT,
+                                         info.height, "pixel-aspect-ratio", GST_TYPE_FRACTION, info.par_n,
+                                         info.par_d, nullptr);
+    if (info.fps_n > 0)
+        gst_caps_set_simple(shape, "framerate", GST_TYPE_FRACTION, info.fps_n, info.fps_d, nullptr);
+    GstCaps* possible = gst_caps_intersect(downstream, shape);
+    gst_caps_unref(shape);
+
+    GstCaps* same = gst_caps_copy(possible);
+    gst_caps_set_simple(same, "format", G_TYPE_STRING, gst_video_format_to_string(GST_VIDEO_INFO_FORMAT(&info)),
+                        nullptr);
+    GstCaps* preferred = gst_caps_intersect(same, possible);
+    gst_caps_unref(same);
+    *result = gst_caps_merge(preferred, possible);
+    GST_DEBUG_OBJECT(self, "output caps %" GST_PTR_FORMAT, static_cast<void*>(*result));
+    return GST_FLOW_OK;
+}
+
+GstCaps* fixateSrcCaps(GstAggregator*, GstCaps* caps)
+{
+    caps = gst_caps_make_writable(caps);
+    GstStructure* s = gst_caps_get_structure(caps, 0);
+    // A colour stream without a frame rate (a still image): the base class' 25 Hz.
+    gst_structure_fixate_field_nearest_fraction(s, "framerate", 25, 1);
+    if (gst_structure_has_field(s, "pixel-aspect-ratio"))
+        gst_structure_fixate_field_nearest_fraction(s, "pixel-aspect-ratio", 1, 1);
+    return gst_caps_fixate(caps);
+}
+
+// ---- streaming -------------------------------------------------------------------------------------
+
+/// Decides whether this output time has a frame: colour and depth both there. The base class
+/// calls it before anything is converted, so a frame that is not made costs nothing.
+GstFlowReturn createOutputBuffer(GstVideoAggregator* vagg, GstBuffer** outbuf)
+{
+    auto* self = GST_DEFOCUS(vagg);
+    GstVideoAggregatorPad *color = nullptr, *depth = nullptr;
+    pads(self, color, depth);
+    GstFlowReturn ret = GST_FLOW_OK;
+    *outbuf = nullptr;
+    if (!depth) {
+        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("No depth stream: link one to the defocus element's 'depth' pad"),
+                          ("defocus needs GRAY16 depth, e.g. '... ! pngdec ! imagefreeze ! d.depth' for one image"));
+        ret = GST_FLOW_ERROR;
+    } else if (!color) {
+        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("No colour stream: link one to the defocus element's 'color' pad"),
+                          (nullptr));
+        ret = GST_FLOW_ERROR;
+    } else if (!gst_video_aggregator_pad_has_current_buffer(color)) {
+        // The colour has ended (depth may go on, e.g. from imagefreeze): so has the output.
+        // Otherwise (a live source, late colour) this output time has no frame.
+        if (gst_aggregator_pad_is_eos(GST_AGGREGATOR_PAD(color)))
+            ret = GST_FLOW_EOS;
+    } else if (!gst_video_aggregator_pad_has_current_buffer(depth)) {
+        if (gst_aggregator_pad_is_eos(GST_AGGREGATOR_PAD(depth))) {
+            GST_ELEMENT_ERROR(self, STREAM, FAILED, ("The depth stream ended before its first frame"), (nullptr));
+            ret = GST_FLOW_ERROR;
+        }
+        // else a live depth stream has not started yet: this colour frame is dropped.
+    } else {
+        ret = GST_VIDEO_AGGREGATOR_CLASS(gst_defocus_parent_class)->create_output_buffer(vagg, outbuf);
+    }
+    if (color)
+        gst_object_unref(color);
+    if (depth)
+        gst_object_unref(depth);
+    return ret;
+}
+
+/// A view of `frame`'s first plane as a cv::Mat (no copy).
+cv::Mat wrap(GstVideoFrame* frame, int type)
+{
+    return cv::Mat(GST_VIDEO_FRAME_HEIGHT(frame), GST_VIDEO_FRAME_WIDTH(frame), type,
+                   GST_VIDEO_FRAME_PLANE_DATA(frame, 0), static_cast<size_t>(GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0)));
+}
+
+/// `color` (the output's format, converted by the colour pad) as the filter's BGR or BGRx.
+cv::Mat toFilter(GstVideoFrame* color)
+{
+    cv::Mat out;
+    switch (GST_VIDEO_FRAME_FORMAT(color)) {
+    case GST_VIDEO_FORMAT_BGRx:
+    case GST_VIDEO_FORMAT_BGRA: return wrap(color, CV_8UC4);
+    case GST_VIDEO_FORMAT_BGR: return wrap(color, CV_8UC3);
+    case GST_VIDEO_FORMAT_RGBx:
+    case GST_VIDEO_FORMAT_RGBA: cv::cvtColor(wrap(color, CV_8UC4), out, cv::COLOR_RGBA2BGR); return out;
+    case GST_VIDEO_FORMAT_RGB: cv::cvtColor(wrap(color, CV_8UC3), out, cv::COLOR_RGB2BGR); return out;
+    default: return out;
+    }
+}
+
+/// The filter's BGR result into `frame`, in its format; alpha (or x) is opaque.
+void fromFilter(const cv::Mat& bgr, GstVideoFrame* frame)
+{
+    // BGRx has three components but four bytes a pixel.
+    cv::Mat out = wrap(frame, GST_VIDEO_FRAME_COMP_PSTRIDE(frame, 0) == 4 ? CV_8UC4 : CV_8UC3);
+    switch (GST_VIDEO_FRAME_FORMAT(frame)) {
+    case GST_VIDEO_FORMAT_BGRx:
+    case GST_VIDEO_FORMAT_BGRA: cv::cvtColor(bgr, out, cv::COLOR_BGR2BGRA); break;
+    case GST_VIDEO_FORMAT_RGBx:
+    case GST_VIDEO_FORMAT_RGBA: cv::cvtColor(bgr, out, cv::COLOR_BGR2RGBA); break;
+    case GST_VIDEO_FORMAT_RGB: cv::cvtColor(bgr, out, cv::COLOR_BGR2RGB); break;
+    default: bgr.copyTo(out); break;
+    }
+}
+
+/// `depth` as CV_16UC1 in the host's byte order.
+cv::Mat depthOf(GstVideoFrame* depth)
+{
+    cv::Mat raw = wrap(depth, CV_16UC1);
+    const bool swap = (GST_VIDEO_FRAME_FORMAT(depth) == GST_VIDEO_FORMAT_GRAY16_BE) != (G_BYTE_ORDER == G_BIG_ENDIAN);
+    if (!swap)
+        return raw;
+    cv::Mat native(raw.size(), CV_16UC1);
+    for (int y = 0; y < raw.rows; ++y) {
+        const auto* in = raw.ptr<guint16>(y);
+        auto* out = native.ptr<guint16>(y);
+        for (int x = 0; x < raw.cols; ++x)
+            out[x] = GUINT16_SWAP_LE_BE(in[x]);
+    }
+    return native;
+}
+
+void postTimings(GstDefocus* self, const defocus::FrameReport& report, GstClockTime pts)
+{
+    GstStructure* gpu = gst_structure_new_empty("gpu-ms");
+    for (const auto& pass : report.timings.gpu)
+        gst_structure_set(gpu, pass.name.c_str(), G_TYPE_DOUBLE, pass.ms, nullptr);
+    GstStructure* s = gst_structure_new(
+        "defocus-timings", "frame", G_TYPE_UINT64, static_cast<guint64>(report.index), "timestamp", G_TYPE_UINT64,
+        static_cast<guint64>(pts), "total-ms", G_TYPE_DOUBLE, report.timings.totalMs, "depth-prep-ms", G_TYPE_DOUBLE,
+        report.timings.depthPrepMs, "analysis-ms", G_TYPE_DOUBLE, report.timings.analysisMs, "upload-ms",
+        G_TYPE_DOUBLE, report.timings.uploadMs, "render-ms", G_TYPE_DOUBLE, report.timings.renderMs, "readback-ms",
+        G_TYPE_DOUBLE, report.timings.readbackMs, "gpu-frame", G_TYPE_UINT64,
+        static_cast<guint64>(report.timings.gpuFrame), "gpu-ms", GST_TYPE_STRUCTURE, gpu, "focus", G_TYPE_DOUBLE,
+        report.focusM, "all-in-focus", G_TYPE_BOOLEAN, report.plan.allInFocus, "tiles", G_TYPE_UINT,
+        static_cast<guint>(report.plan.tiles), "blur-tiles", G_TYPE_UINT, static_cast<guint>(report.plan.blurTiles),
+        "plan", G_TYPE_STRING, report.plan.explain.c_str(), nullptr);
+    gst_structure_free(gpu);
+    gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), s));
+}
+
+/// The properties as the filter takes them: out-of-range combinations (a focus nearer than the
+/// focal length, near beyond the focus) are clamped, each posted once as a warning.
+defocus::Settings currentSettings(GstDefocus* self, bool& changed, bool& post)
+{
+    State& s = *self->state;
+    defocus::Settings settings;
+    {
+        std::lock_guard guard(s.lock);
+        settings = s.settings;
+        if (!s.nearFieldSet)
+            settings.quality.nearField.reset();
+        changed = s.generation != s.applied;
+        s.applied = s.generation;
+        post = s.postTimings;
+    }
+    if (changed)
+        for (const std::string& problem : defocus::check(settings, true))
+            if (s.warned.insert(problem).second)
+                GST_ELEMENT_WARNING(self, LIBRARY, SETTINGS, ("%s", problem.c_str()),
+                                    ("clamped to the nearest allowed value"));
+    return settings;
+}
+
+GstFlowReturn aggregateFrames(GstVideoAggregator* vagg, GstBuffer* outbuf)
+{
+    auto* self = GST_DEFOCUS(vagg);
+    State& s = *self->state;
+    GstAggregator* agg = GST_AGGREGATOR(vagg);
+
+    // Keyframed properties (GstController) at this frame's stream time.
+    const GstClockTime pts = GST_BUFFER_PTS(outbuf);
+    GST_OBJECT_LOCK(agg->srcpad);
+    const GstSegment segment = GST_AGGREGATOR_PAD(agg->srcpad)->segment;
+    GST_OBJECT_UNLOCK(agg->srcpad);
+    const GstClockTime streamTime = gst_segment_to_stream_time(&segment, GST_FORMAT_TIME, pts);
+    if (GST_CLOCK_TIME_IS_VALID(streamTime))
+        gst_object_sync_values(GST_OBJECT(self), streamTime);
+
+    bool changed = false, post = false;
+    const defocus::Settings settings = currentSettings(self, changed, post);
+
+    try {
+        if (!s.filter) {
+            // Made here, on the streaming thread, the first time a frame needs it.
+            s.filter = std::make_unique<defocus::Filter>(settings);
+            GST_INFO_OBJECT(self, "filtering on %s", s.filter->renderer().c_str());
+        } else if (changed) {
+            s.filter->setSettings(settings);
+        }
+    } catch (const defocus::GlError& error) {
+        GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("No OpenGL 4.5 for the defocus filter"), ("%s", error.what()));
+        return GST_FLOW_ERROR;
+    } catch (const defocus::Error& error) {
+        GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("%s", error.what()), (nullptr));
+        return GST_FLOW_ERROR;
+    }
+    if (s.resetPending) {
+        s.filter->reset();
+        s.resetPending = false;
+    }
+
+    GstVideoAggregatorPad *colorPad = nullptr, *depthPad = nullptr;
+    pads(self, colorPad, depthPad);
+    GstVideoFrame* color = colorPad ? gst_video_aggregator_pad_get_prepared_frame(colorPad) : nullptr;
+    GstVideoFrame* depth = depthPad ? gst_video_aggregator_pad_get_prepared_frame(depthPad) : nullptr;
+    GstFlowReturn ret = GST_FLOW_OK;
+    GstVideoFrame out;
+    if (!color || !depth || !color->buffer || !depth->buffer) {
+        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("A colour or depth frame could not be mapped"), (nullptr));
+        ret = GST_FLOW_ERROR;
+    } else if (!gst_video_frame_map(&out, &vagg->info, outbuf, GST_MAP_WRITE)) {
+        GST_ELEMENT_ERROR(self, RESOURCE, WRITE, ("The output buffer could not be mapped"), (nullptr));
+        ret = GST_FLOW_ERROR;
+    } else {
+        try {
+            const GstClockTime running = gst_segment_to_running_time(&segment, GST_FORMAT_TIME, pts);
+            const double seconds = GST_CLOCK_TIME_IS_VALID(running) ? static_cast<double>(running) / GST_SECOND : 0.0;
+            const cv::Mat result = s.filter->process(toFilter(color), depthOf(depth), seconds);
+            fromFilter(result, &out);
+            if (post)
+                postTimings(self, s.filter->lastFrame(), pts);
+        } catch (const defocus::Error& error) {
+            GST_ELEMENT_ERROR(self, STREAM, FORMAT, ("%s", error.what()), (nullptr));
+            ret = GST_FLOW_ERROR;
+        } catch (const cv::Exception& error) {
+            GST_ELEMENT_ERROR(self, STREAM, FAILED, ("%s", error.what()), (nullptr));
+            ret = GST_FLOW_ERROR;
+        }
+        gst_video_frame_unmap(&out);
+    }
+    // The streaming thread may be another one after a seek or a pause: let it take the context.
+    s.filter->release();
+    if (colorPad)
+        gst_object_unref(colorPad);
+    if (depthPad)
+        gst_object_unref(depthPad);
+    return ret;
+}
+
+GstFlowReturn flush(GstAggregator* agg)
+{
+    stateOf(agg).resetPending = true;
+    return GST_AGGREGATOR_CLASS(gst_defocus_parent_class)->flush(agg);
+}
+
+gboolean stop(GstAggregator* agg)
+{
+    State& s = stateOf(agg);
+    // The streaming task has stopped and released the context: it can be made current here.
+    s.filter.reset();
+    s.warned.clear();
+    s.resetPending = false;
+    {
+        std::lock_guard guard(s.lock);
+        s.applied = 0;
+    }
+    return GST_AGGREGATOR_CLASS(gst_defocus_parent_class)->stop(agg);
+}
+
+void finalize(GObject* object)
+{
+    delete GST_DEFOCUS(object)->state;
+    G_OBJECT_CLASS(gst_defocus_parent_class)->finalize(object);
+}
+
+void installDouble(GObjectClass* klass, guint id, const char* name, const char* blurb, double low, double high,
+                   double value, GParamFlags flags = kFlags)
+{
+    g_object_class_install_property(klass, id, g_param_spec_double(name, name, blurb, low, high, value, flags));
+}
+
+} // namespace
+
+static void gst_defocus_class_init(GstDefocusClass* klass)
+{
+    GST_DEBUG_CATEGORY_INIT(gst_defocus_debug, "defocus", 0, "defocus depth-of-field filter");
+    auto* gobject = G_OBJECT_CLASS(klass);
+    auto* element = GST_ELEMENT_CLASS(klass);
+    auto* agg = GST_AGGREGATOR_CLASS(klass);
+    auto* vagg = GST_VIDEO_AGGREGATOR_CLASS(klass);
+
+    gobject->set_property = setProperty;
+    gobject->get_property = getProperty;
+    gobject->finalize = finalize;
+
+    // Ranges and defaults are the command line's (`defocus --help`).
+    installDouble(gobject, PROP_FOCUS, "focus",
+                  "Distance in focus, metres ('inf' for infinity); setting it turns autofocus off", 0.001, INFINITY,
+                  2.0, kControllable);
+    g_object_class_install_property(
+        gobject, PROP_AUTOFOCUS,
+        g_param_spec_boolean("autofocus", "autofocus",
+                             "Follow the depth of the centre of the frame (a critically damped spring in dioptres); "
+                             "off: the focus property",
+                             TRUE, kFlags));
+    installDouble(gobject, PROP_AUTOFOCUS_TIME_CONSTANT, "autofocus-time-constant",
+                  "Autofocus time constant, seconds (a step is 95 % done after 4.7 of them; 0 jumps)", 0.0, 10.0, 0.25);
+    installDouble(gobject, PROP_F_NUMBER, "f-number", "Aperture as an f-number N (smaller = more blur)", 0.7, 64.0,
+                  2.0, kControllable);
+    installDouble(gobject, PROP_FOCAL_LENGTH, "focal-length", "Lens focal length, millimetres", 1.0, 1200.0, 50.0,
+                  kControllable);
+    installDouble(gobject, PROP_SENSOR_WIDTH, "sensor-width", "Sensor width the image spans, millimetres", 1.0, 100.0,
+                  36.0, kControllable);
+    g_object_class_install_property(
+        gobject, PROP_FOV_FROM,
+        g_param_spec_enum("fov-from", "fov-from", "Where the sensor width spans the image", fovFromType(), 0, kFlags));
+    installDouble(gobject, PROP_MAX_COC, "max-coc", "Largest blur diameter, pixels", 0.0, 512.0, 32.0, kControllable);
+    g_object_class_install_property(
+        gobject, PROP_COC_MODEL,
+        g_param_spec_enum("coc-model", "coc-model", "How depth becomes blur", cocModelType(), 0, kFlags));
+    installDouble(gobject, PROP_NEAR, "near", "focal-range model: metres where near blur reaches max-coc", 0.0,
+                  G_MAXDOUBLE, 1.0, kControllable);
+    installDouble(gobject, PROP_FAR, "far", "focal-range model: metres where far blur reaches max-coc", 0.0, INFINITY,
+                  6.0, kControllable);
+    g_object_class_install_property(
+        gobject, PROP_QUALITY,
+        g_param_spec_enum("quality", "quality",
+                          "Preset from the accuracy benchmark; samples, hexagon, precision, resolution and near-field "
+                          "override it",
+                          qualityType(), 1, kFlags));
+    g_object_class_install_property(
+        gobject, PROP_SAMPLES,
+        g_param_spec_int("samples", "samples", "Taps per directional blur, 2..64; 0 = the quality preset's", 0, 64, 0,
+                         kFlags));
+    g_object_class_install_property(
+        gobject, PROP_HEXAGON,
+        g_param_spec_enum("hexagon", "hexagon", "How the blurs make the hexagon", hexagonType(), 0, kFlags));
+    g_object_class_install_property(
+        gobject, PROP_PRECISION,
+        g_param_spec_enum("precision", "precision", "Intermediate render targets", precisionType(), 0, kFlags));
+    g_object_class_install_property(
+        gobject, PROP_RESOLUTION,
+        g_param_spec_enum("resolution", "resolution", "Size the blurs run at", resolutionType(), 0, kFlags));
+    g_object_class_install_property(
+        gobject, PROP_NEAR_FIELD,
+        g_param_spec_boolean("near-field", "near-field",
+                             "Spread blurred foreground over what is behind it (every preset: on; setting it "
+                             "overrides the preset)",
+                             TRUE, kFlags));
+    g_object_class_install_property(
+        gobject, PROP_HIGHLIGHT_SPRITES,
+        g_param_spec_boolean("highlight-sprites", "highlight-sprites",
+                             "Rhombi: lights brighter than white scatter as hexagons with exact edges", TRUE, kFlags));
+    installDouble(gobject, PROP_HIGHLIGHT_GAIN, "highlight-gain",
+                  "Scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off)", 1.0, 64.0, 1.0);
+    installDouble(gobject, PROP_BLADE_ROTATION, "blade-rotation",
+                  "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top, 30 = flat top", -180.0, 180.0, 0.0,
+                  kControllable);
+    installDouble(gobject, PROP_DEPTH_SCALE, "depth-scale", "Units per metre of the 16-bit depth (TUM RGB-D: 5000)",
+                  1e-3, G_MAXDOUBLE, 1000.0);
+    g_object_class_install_property(
+        gobject, PROP_VIEW,
+        g_param_spec_enum("view", "view", "What to output", viewType(), 4, kFlags));
+    g_object_class_install_property(
+        gobject, PROP_POST_TIMINGS,
+        g_param_spec_boolean("post-timings", "post-timings",
+                             "Post each frame's timings and plan as a 'defocus-timings' element message", FALSE,
+                             kFlags));
+
+    gst_element_class_set_static_metadata(
+        element, "Depth of field", "Filter/Effect/Video",
+        "Gives colour + depth video the depth of field of a real lens, with hexagonal bokeh (OpenGL 4.5, headless EGL)",
+        "defocus developers");
+    gst_element_class_add_static_pad_template(element, &srcTemplate);
+    gst_element_class_add_static_pad_template_with_gtype(element, &colorTemplate, GST_TYPE_VIDEO_AGGREGATOR_CONVERT_PAD);
+    gst_element_class_add_static_pad_template_with_gtype(element, &depthTemplate, GST_TYPE_VIDEO_AGGREGATOR_PAD);
+    element->release_pad = releasePad;
+
+    agg->create_new_pad = createNewPad;
+    agg->sink_query = sinkQuery;
+    agg->update_src_caps = updateSrcCaps;
+    agg->fixate_src_caps = fixateSrcCaps;
+    agg->flush = flush;
+    agg->stop = stop;
+    vagg->create_output_buffer = createOutputBuffer;
+    vagg->aggregate_frames = aggregateFrames;
+    vagg->find_best_format = nullptr;
+}
+
+static void gst_defocus_init(GstDefocus* self)
+{
+    self->state = new State;
+    // The command line's default focus is automatic; a live stream follows it.
+    self->state->settings.autofocus.mode = defocus::AutofocusOptions::Mode::Follow;
+}
+
+static gboolean plugin_init(GstPlugin* plugin)
+{
+    return gst_element_register(plugin, "defocus", GST_RANK_NONE, GST_TYPE_DEFOCUS);
+}
+
+#define PACKAGE "defocus"
+GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, defocus,
+                  "Depth of field with hexagonal bokeh for colour + depth video", plugin_init, DEFOCUS_VERSION,
+                  "unknown", "defocus", "https://github.com/defocus/defocus")

@@ -1,0 +1,469 @@
+// The `defocus` element through GstHarness: colour and depth pushed, the result pulled and held
+// equal, byte for byte, to libdefocus on the same frame; passthrough, property changes,
+// keyframed focus, EOS on either pad, flushing, caps it refuses, and the errors it posts.
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <defocus/defocus.hpp>
+#include <gst/check/gstharness.h>
+#include <gst/controller/gstinterpolationcontrolsource.h>
+#include <gst/controller/gstdirectcontrolbinding.h>
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace {
+
+constexpr GstClockTime kFrame = GST_SECOND / 30;
+
+struct Rgbd {
+    cv::Mat bgr;     ///< CV_8UC3
+    cv::Mat depth16; ///< CV_16UC1, 5000 units per metre (TUM)
+};
+
+/// Line `line` (from 1) of the bundled clip's associations: colour and its depth.
+Rgbd bundledFrame(int line)
+{
+    std::ifstream list(std::string(DEFOCUS_DATA_DIR) + "/tum_fr1_rpy/associations.txt");
+    std::string text;
+    for (int i = 0; i < line; ++i)
+        std::getline(list, text);
+    std::istringstream fields(text);
+    std::string t1, rgb, t2, depth;
+    fields >> t1 >> rgb >> t2 >> depth;
+    const std::string dir = std::string(DEFOCUS_DATA_DIR) + "/tum_fr1_rpy/";
+    return {cv::imread(dir + rgb, cv::IMREAD_COLOR), cv::imread(dir + depth, cv::IMREAD_UNCHANGED)};
+}
+
+GstBuffer* bufferOf(const cv::Mat& image, GstClockTime pts)
+{
+    const cv::Mat packed = image.isContinuous() ? image : image.clone();
+    const gsize size = packed.total() * packed.elemSize();
+    GstBuffer* buffer = gst_buffer_new_allocate(nullptr, size, nullptr);
+    gst_buffer_fill(buffer, 0, packed.data, size);
+    GST_BUFFER_PTS(buffer) = pts;
+    GST_BUFFER_DURATION(buffer) = kFrame;
+    return buffer;
+}
+
+/// Copies `buffer` (tightly packed `type` pixels of `size`) into a cv::Mat and unrefs it.
+cv::Mat matOf(GstBuffer* buffer, cv::Size size, int type)
+{
+    cv::Mat out(size, type);
+    EXPECT_EQ(gst_buffer_get_size(buffer), out.total() * out.elemSize());
+    gst_buffer_extract(buffer, 0, out.data, out.total() * out.elemSize());
+    gst_buffer_unref(buffer);
+    return out;
+}
+
+std::string caps(const char* format, cv::Size size)
+{
+    return "video/x-raw,format=" + std::string(format) + ",width=" + std::to_string(size.width) +
+           ",height=" + std::to_string(size.height) + ",framerate=30/1";
+}
+
+/// Success when `a` and `b` are the same image, byte for byte; else how they differ.
+::testing::AssertionResult identical(const cv::Mat& a, const cv::Mat& b)
+{
+    if (a.size() != b.size() || a.type() != b.type())
+        return ::testing::AssertionFailure() << "sizes or types differ";
+    cv::Mat diff;
+    cv::absdiff(a, b, diff);
+    const int differing = cv::countNonZero(diff.reshape(1));
+    if (differing == 0)
+        return ::testing::AssertionSuccess();
+    double largest = 0;
+    cv::minMaxLoc(diff.reshape(1), nullptr, &largest);
+    return ::testing::AssertionFailure() << differing << " samples differ, by up to " << largest;
+}
+
+/// The element with two harnesses: `color` also pulls from src.
+struct Element {
+    GstElement* element = nullptr;
+    GstHarness* color = nullptr;
+    GstHarness* depth = nullptr;
+    GstBus* bus = gst_bus_new();
+
+    /// `properties`: "name=value" pairs as gst-launch takes them.
+    explicit Element(const std::vector<std::string>& properties, bool withDepth = true)
+    {
+        element = gst_element_factory_make("defocus", nullptr);
+        if (!element)
+            return;
+        gst_element_set_bus(element, bus);
+        for (const auto& property : properties) {
+            const auto eq = property.find('=');
+            gst_util_set_object_arg(G_OBJECT(element), property.substr(0, eq).c_str(),
+                                    property.substr(eq + 1).c_str());
+        }
+        // Not live: the element waits for colour and depth of each frame, however long a frame
+        // takes (a live pipeline drops a colour frame whose depth is late).
+        color = gst_harness_new_with_element(element, "color", "src");
+        gst_harness_set_live(color, FALSE);
+        if (withDepth) {
+            depth = gst_harness_new_with_element(element, "depth", nullptr);
+            gst_harness_set_live(depth, FALSE);
+        }
+    }
+    ~Element()
+    {
+        if (depth)
+            gst_harness_teardown(depth);
+        if (color)
+            gst_harness_teardown(color);
+        if (element)
+            gst_object_unref(element);
+        gst_object_unref(bus);
+    }
+    void setCaps(const char* colorFormat, cv::Size colorSize, const char* depthFormat, cv::Size depthSize,
+                 const char* outFormat)
+    {
+        gst_harness_set_src_caps_str(color, caps(colorFormat, colorSize).c_str());
+        if (depth)
+            gst_harness_set_src_caps_str(depth, caps(depthFormat, depthSize).c_str());
+        gst_harness_set_sink_caps_str(color, ("video/x-raw,format=" + std::string(outFormat)).c_str());
+    }
+    /// The first error posted within 10 s, or "".
+    std::string error()
+    {
+        GstMessage* message = gst_bus_timed_pop_filtered(bus, 10 * GST_SECOND, GST_MESSAGE_ERROR);
+        if (!message)
+            return {};
+        GError* err = nullptr;
+        gchar* debug = nullptr;
+        gst_message_parse_error(message, &err, &debug);
+        std::string text = err->message;
+        g_error_free(err);
+        g_free(debug);
+        gst_message_unref(message);
+        return text;
+    }
+};
+
+/// The library's result for the element's settings below.
+cv::Mat library(const defocus::Settings& settings, const cv::Mat& color, const cv::Mat& depth)
+{
+    defocus::Filter filter(settings);
+    return filter.process(color, depth);
+}
+
+defocus::Settings lensSettings()
+{
+    defocus::Settings s;
+    s.lens.focusM = 1.0;
+    s.lens.fNumber = 1.4;
+    s.depthScale = 5000;
+    return s;
+}
+const std::vector<std::string> kLens{"autofocus=false", "focus=1.0", "f-number=1.4", "depth-scale=5000"};
+
+class GstDefocus : public ::testing::Test {
+protected:
+    void SetUp() override
+    {
+        GstElementFactory* factory = gst_element_factory_find("defocus");
+        ASSERT_NE(factory, nullptr) << "the defocus plugin is not in " DEFOCUS_GST_PLUGIN_DIR;
+        gst_object_unref(factory);
+        frame_ = bundledFrame(9);
+        ASSERT_FALSE(frame_.bgr.empty());
+    }
+    Rgbd frame_;
+};
+
+struct Variant {
+    const char* name;
+    const char* properties; ///< the element's, besides the lens
+    defocus::Quality quality;
+};
+
+class GstDefocusMatchesLibrary : public GstDefocus, public ::testing::WithParamInterface<Variant> {};
+
+// Defect caught: the element converting, pairing or setting up differently from the library
+// (a property not passed on, a row stride ignored, colour channels swapped): any byte differs.
+TEST_P(GstDefocusMatchesLibrary, TwoFramesByteForByte)
+{
+    std::vector<std::string> properties = kLens;
+    std::istringstream extra(GetParam().properties);
+    for (std::string p; extra >> p;)
+        properties.push_back(p);
+    Element e(properties);
+    e.setCaps("BGR", frame_.bgr.size(), "GRAY16_LE", frame_.depth16.size(), "BGR");
+    defocus::Settings settings = lensSettings();
+    settings.quality = GetParam().quality;
+    const Rgbd second = bundledFrame(3);
+    for (int i = 0; i < 2; ++i) {
+        const Rgbd& f = i == 0 ? frame_ : second;
+        ASSERT_EQ(gst_harness_push(e.color, bufferOf(f.bgr, i * kFrame)), GST_FLOW_OK);
+        ASSERT_EQ(gst_harness_push(e.depth, bufferOf(f.depth16, i * kFrame)), GST_FLOW_OK);
+        const cv::Mat out = matOf(gst_harness_pull(e.color), f.bgr.size(), CV_8UC3);
+        EXPECT_TRUE(identical(out, library(settings, f.bgr, f.depth16))) << "frame " << i;
+        EXPECT_FALSE(identical(out, f.bgr)) << "frame " << i << " was not blurred";
+    }
+}
+
+defocus::Quality quality(defocus::Quality::Preset preset, std::optional<defocus::Quality::Hexagon> hexagon = {})
+{
+    defocus::Quality q;
+    q.preset = preset;
+    q.hexagon = hexagon;
+    return q;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    PresetsAndKernels, GstDefocusMatchesLibrary,
+    ::testing::Values(Variant{"balanced", "", quality(defocus::Quality::Preset::Balanced)},
+                      Variant{"fast", "quality=fast", quality(defocus::Quality::Preset::Fast)},
+                      Variant{"high", "quality=high", quality(defocus::Quality::Preset::High)},
+                      Variant{"mcintosh", "hexagon=mcintosh",
+                              quality(defocus::Quality::Preset::Balanced, defocus::Quality::Hexagon::McIntosh)}),
+    [](const ::testing::TestParamInfo<Variant>& param) { return std::string(param.param.name); });
+
+// Defect caught: the RGB-order or 4-byte paths (RGBx in and out) or big-endian depth (what
+// pngdec gives) read wrongly: a swapped channel or byte order changes the result.
+TEST_F(GstDefocus, RgbxColourAndBigEndianDepthMatchTheLibrary)
+{
+    Element e(kLens);
+    e.setCaps("RGBx", frame_.bgr.size(), "GRAY16_BE", frame_.depth16.size(), "RGBx");
+    cv::Mat rgbx, depthBe(frame_.depth16.size(), CV_16UC1);
+    cv::cvtColor(frame_.bgr, rgbx, cv::COLOR_BGR2RGBA);
+    for (int y = 0; y < depthBe.rows; ++y)
+        for (int x = 0; x < depthBe.cols; ++x)
+            depthBe.at<uint16_t>(y, x) = GUINT16_SWAP_LE_BE(frame_.depth16.at<uint16_t>(y, x));
+    ASSERT_EQ(gst_harness_push(e.color, bufferOf(rgbx, 0)), GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(e.depth, bufferOf(depthBe, 0)), GST_FLOW_OK);
+    const cv::Mat out = matOf(gst_harness_pull(e.color), frame_.bgr.size(), CV_8UC4);
+    cv::Mat expected;
+    cv::cvtColor(library(lensSettings(), frame_.bgr, frame_.depth16), expected, cv::COLOR_BGR2RGBA);
+    EXPECT_TRUE(identical(out, expected));
+}
+
+// Defect caught: an all-in-focus frame changed on its way through (a colour conversion that
+// rounds, an sRGB round trip, the alpha lost): with no blur the output is the input, exactly.
+TEST_F(GstDefocus, InFocusPassesThroughBitExact)
+{
+    for (const char* format : {"BGRx", "BGR"}) {
+        Element e({"autofocus=false", "max-coc=0"});
+        e.setCaps(format, frame_.bgr.size(), "GRAY16_LE", frame_.depth16.size(), format);
+        cv::Mat in = frame_.bgr;
+        if (std::string(format) == "BGRx")
+            cv::cvtColor(frame_.bgr, in, cv::COLOR_BGR2BGRA);
+        ASSERT_EQ(gst_harness_push(e.color, bufferOf(in, 0)), GST_FLOW_OK);
+        ASSERT_EQ(gst_harness_push(e.depth, bufferOf(frame_.depth16, 0)), GST_FLOW_OK);
+        EXPECT_TRUE(identical(matOf(gst_harness_pull(e.color), in.size(), in.type()), in)) << format;
+    }
+}
+
+// Defect caught: a property set while playing ignored (settings read once) or applied late.
+TEST_F(GstDefocus, PropertyChangeTakesEffectOnTheNextFrame)
+{
+    Element e(kLens);
+    e.setCaps("BGR", frame_.bgr.size(), "GRAY16_LE", frame_.depth16.size(), "BGR");
+    ASSERT_EQ(gst_harness_push(e.color, bufferOf(frame_.bgr, 0)), GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(e.depth, bufferOf(frame_.depth16, 0)), GST_FLOW_OK);
+    const cv::Mat first = matOf(gst_harness_pull(e.color), frame_.bgr.size(), CV_8UC3);
+    g_object_set(e.element, "f-number", 8.0, nullptr);
+    ASSERT_EQ(gst_harness_push(e.color, bufferOf(frame_.bgr, kFrame)), GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(e.depth, bufferOf(frame_.depth16, kFrame)), GST_FLOW_OK);
+    const cv::Mat second = matOf(gst_harness_pull(e.color), frame_.bgr.size(), CV_8UC3);
+    defocus::Settings f8 = lensSettings();
+    f8.lens.fNumber = 8.0;
+    EXPECT_TRUE(identical(first, library(lensSettings(), frame_.bgr, frame_.depth16)));
+    EXPECT_TRUE(identical(second, library(f8, frame_.bgr, frame_.depth16)));
+    EXPECT_FALSE(identical(first, second));
+}
+
+// Defect caught: keyframes not applied per frame (gst_object_sync_values missing, or called with
+// running instead of stream time) or timings not posted: the focus of each frame's message and
+// its image follow the linear ramp 1 m + 2 m/s * t.
+TEST_F(GstDefocus, KeyframedFocusPullAndTimingMessages)
+{
+    Element e({"f-number=1.4", "depth-scale=5000", "post-timings=true"});
+    GstControlSource* ramp = gst_interpolation_control_source_new();
+    g_object_set(ramp, "mode", GST_INTERPOLATION_MODE_LINEAR, nullptr);
+    // The direct binding maps [0, 1] onto the property's own range [0.001, inf]: set absolute.
+    gst_object_add_control_binding(GST_OBJECT(e.element),
+                                   gst_direct_control_binding_new_absolute(GST_OBJECT(e.element), "focus", ramp));
+    gst_timed_value_control_source_set(GST_TIMED_VALUE_CONTROL_SOURCE(ramp), 0, 1.0);
+    gst_timed_value_control_source_set(GST_TIMED_VALUE_CONTROL_SOURCE(ramp), GST_SECOND, 3.0);
+    e.setCaps("BGR", frame_.bgr.size(), "GRAY16_LE", frame_.depth16.size(), "BGR");
+    for (int i = 0; i < 3; ++i) {
+        ASSERT_EQ(gst_harness_push(e.color, bufferOf(frame_.bgr, i * kFrame)), GST_FLOW_OK);
+        ASSERT_EQ(gst_harness_push(e.depth, bufferOf(frame_.depth16, i * kFrame)), GST_FLOW_OK);
+        const cv::Mat out = matOf(gst_harness_pull(e.color), frame_.bgr.size(), CV_8UC3);
+        const double expected = 1.0 + 2.0 * static_cast<double>(i * kFrame) / GST_SECOND;
+        GstMessage* message = gst_bus_timed_pop_filtered(e.bus, 5 * GST_SECOND, GST_MESSAGE_ELEMENT);
+        ASSERT_NE(message, nullptr);
+        const GstStructure* s = gst_message_get_structure(message);
+        ASSERT_TRUE(gst_structure_has_name(s, "defocus-timings"));
+        double focus = 0, total = 0;
+        guint64 index = 99;
+        ASSERT_TRUE(gst_structure_get_double(s, "focus", &focus));
+        ASSERT_TRUE(gst_structure_get_double(s, "total-ms", &total));
+        ASSERT_TRUE(gst_structure_get_uint64(s, "frame", &index));
+        EXPECT_NEAR(focus, expected, 1e-9) << "frame " << i;
+        EXPECT_GT(total, 0.0);
+        EXPECT_EQ(index, static_cast<guint64>(i));
+        EXPECT_NE(std::string(gst_structure_get_string(s, "plan")), "");
+        gst_message_unref(message);
+        defocus::Settings settings = lensSettings();
+        settings.lens.focusM = focus;
+        EXPECT_TRUE(identical(out, library(settings, frame_.bgr, frame_.depth16))) << "frame " << i;
+    }
+    gst_object_unref(ramp);
+}
+
+// Defect caught: the stream stalling or ending when its depth ends (one still depth image), or
+// running on forever when its colour ends while depth goes on (imagefreeze).
+TEST_F(GstDefocus, DepthEosKeepsTheLastDepthAndColourEosEndsTheStream)
+{
+    Element e(kLens);
+    e.setCaps("BGR", frame_.bgr.size(), "GRAY16_LE", frame_.depth16.size(), "BGR");
+    ASSERT_EQ(gst_harness_push(e.color, bufferOf(frame_.bgr, 0)), GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(e.depth, bufferOf(frame_.depth16, 0)), GST_FLOW_OK);
+    gst_buffer_unref(gst_harness_pull(e.color));
+    ASSERT_TRUE(gst_harness_push_event(e.depth, gst_event_new_eos()));
+    const Rgbd other = bundledFrame(5);
+    for (int i = 1; i < 3; ++i) {
+        ASSERT_EQ(gst_harness_push(e.color, bufferOf(other.bgr, i * kFrame)), GST_FLOW_OK);
+        const cv::Mat out = matOf(gst_harness_pull(e.color), frame_.bgr.size(), CV_8UC3);
+        EXPECT_TRUE(identical(out, library(lensSettings(), other.bgr, frame_.depth16))) << "frame " << i;
+    }
+    ASSERT_TRUE(gst_harness_push_event(e.color, gst_event_new_eos()));
+    bool eos = false;
+    for (GstEvent* event; !eos && (event = gst_harness_pull_event(e.color));) {
+        eos = GST_EVENT_TYPE(event) == GST_EVENT_EOS;
+        gst_event_unref(event);
+    }
+    EXPECT_TRUE(eos);
+
+    Element live(kLens);
+    live.setCaps("BGR", frame_.bgr.size(), "GRAY16_LE", frame_.depth16.size(), "BGR");
+    ASSERT_EQ(gst_harness_push(live.color, bufferOf(frame_.bgr, 0)), GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(live.depth, bufferOf(frame_.depth16, 0)), GST_FLOW_OK);
+    gst_buffer_unref(gst_harness_pull(live.color));
+    ASSERT_TRUE(gst_harness_push_event(live.color, gst_event_new_eos()));
+    gst_harness_push(live.depth, bufferOf(frame_.depth16, kFrame));
+    eos = false;
+    for (GstEvent* event; !eos && (event = gst_harness_pull_event(live.color));) {
+        eos = GST_EVENT_TYPE(event) == GST_EVENT_EOS;
+        gst_event_unref(event);
+    }
+    EXPECT_TRUE(eos);
+}
+
+// Defect caught: a flushing seek leaving the element stalled or erroring: after flush-start /
+// flush-stop on both pads and a new segment, frames flow again and still match the library.
+TEST_F(GstDefocus, FlushThenStreamAgain)
+{
+    Element e(kLens);
+    e.setCaps("BGR", frame_.bgr.size(), "GRAY16_LE", frame_.depth16.size(), "BGR");
+    ASSERT_EQ(gst_harness_push(e.color, bufferOf(frame_.bgr, 0)), GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(e.depth, bufferOf(frame_.depth16, 0)), GST_FLOW_OK);
+    gst_buffer_unref(gst_harness_pull(e.color));
+    // One flush on both inputs, as a flushing seek makes upstream send it (one sequence number).
+    const guint32 seqnum = gst_util_seqnum_next();
+    for (GstHarness* h : {e.color, e.depth}) {
+        GstEvent* start = gst_event_new_flush_start();
+        GstEvent* stop = gst_event_new_flush_stop(TRUE);
+        gst_event_set_seqnum(start, seqnum);
+        gst_event_set_seqnum(stop, seqnum);
+        ASSERT_TRUE(gst_harness_push_event(h, start));
+        ASSERT_TRUE(gst_harness_push_event(h, stop));
+        GstSegment segment;
+        gst_segment_init(&segment, GST_FORMAT_TIME);
+        ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_segment(&segment)));
+    }
+    const Rgbd other = bundledFrame(5);
+    ASSERT_EQ(gst_harness_push(e.color, bufferOf(other.bgr, 0)), GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(e.depth, bufferOf(other.depth16, 0)), GST_FLOW_OK);
+    GstBuffer* out = nullptr;
+    // Buffers queued before the flush are gone; the first one after it is the new frame.
+    while ((out = gst_harness_pull(e.color)) && GST_BUFFER_PTS(out) != 0)
+        gst_buffer_unref(out);
+    ASSERT_NE(out, nullptr);
+    EXPECT_TRUE(identical(matOf(out, other.bgr.size(), CV_8UC3), library(lensSettings(), other.bgr, other.depth16)));
+}
+
+// Defect caught: caps the element cannot use accepted (8-bit depth read as 16-bit).
+TEST_F(GstDefocus, RefusesDepthThatIsNotSixteenBit)
+{
+    Element e(kLens);
+    e.setCaps("BGR", frame_.bgr.size(), "GRAY8", frame_.depth16.size(), "BGR");
+    cv::Mat depth8(frame_.depth16.size(), CV_8UC1, cv::Scalar(100));
+    EXPECT_EQ(gst_harness_push(e.depth, bufferOf(depth8, 0)), GST_FLOW_NOT_NEGOTIATED);
+}
+
+// Defect caught: depth of another aspect ratio stretched over the colour instead of refused
+// with the command line's message.
+TEST_F(GstDefocus, DepthOfAnotherAspectRatioIsAnError)
+{
+    Element e(kLens);
+    const cv::Size square(480, 480);
+    e.setCaps("BGR", frame_.bgr.size(), "GRAY16_LE", square, "BGR");
+    ASSERT_EQ(gst_harness_push(e.color, bufferOf(frame_.bgr, 0)), GST_FLOW_OK);
+    gst_harness_push(e.depth, bufferOf(cv::Mat(square, CV_16UC1, cv::Scalar(5000)), 0));
+    EXPECT_NE(e.error().find("aspect ratios"), std::string::npos);
+}
+
+// Defect caught: a pipeline with no depth stream stalling or crashing instead of saying so.
+TEST_F(GstDefocus, NoDepthStreamIsAClearError)
+{
+    Element e(kLens, false);
+    gst_harness_set_src_caps_str(e.color, caps("BGR", frame_.bgr.size()).c_str());
+    gst_harness_set_sink_caps_str(e.color, "video/x-raw,format=BGR");
+    gst_harness_push(e.color, bufferOf(frame_.bgr, 0));
+    EXPECT_NE(e.error().find("No depth stream"), std::string::npos);
+}
+
+// Defect caught: a live pipeline that stalls (the element waiting for data a live source gives
+// only in time), or that reports no latency of its own, so that a live sink drops every frame.
+TEST_F(GstDefocus, LiveSourcesFlowAndLatencyIsReported)
+{
+    GError* error = nullptr;
+    GstElement* pipeline = gst_parse_launch(
+        "defocus name=d autofocus=false focus=1.0 post-timings=true ! fakesink sync=true "
+        "videotestsrc is-live=true ! video/x-raw,format=BGR,width=160,height=120,framerate=30/1 ! d.color "
+        "videotestsrc is-live=true pattern=solid-color foreground-color=0xff404040 "
+        "! video/x-raw,format=GRAY16_LE,width=160,height=120,framerate=30/1 ! d.depth",
+        &error);
+    ASSERT_EQ(error, nullptr) << error->message;
+    GstBus* bus = gst_element_get_bus(pipeline);
+    ASSERT_NE(gst_element_set_state(pipeline, GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);
+    int frames = 0;
+    while (frames < 10) {
+        GstMessage* message =
+            gst_bus_timed_pop_filtered(bus, 10 * GST_SECOND, static_cast<GstMessageType>(GST_MESSAGE_ELEMENT | GST_MESSAGE_ERROR));
+        ASSERT_NE(message, nullptr) << "no frame for 10 s after " << frames;
+        ASSERT_NE(GST_MESSAGE_TYPE(message), GST_MESSAGE_ERROR);
+        frames += gst_structure_has_name(gst_message_get_structure(message), "defocus-timings") ? 1 : 0;
+        gst_message_unref(message);
+    }
+    GstQuery* query = gst_query_new_latency();
+    ASSERT_TRUE(gst_element_query(pipeline, query));
+    gboolean live = FALSE;
+    GstClockTime min = 0, max = 0;
+    gst_query_parse_latency(query, &live, &min, &max);
+    EXPECT_TRUE(live);
+    // videotestsrc's own frame, and the element's (one output frame to filter in).
+    EXPECT_GE(min, 2 * kFrame);
+    gst_query_unref(query);
+    gst_element_set_state(pipeline, GST_STATE_NULL);
+    gst_object_unref(bus);
+    gst_object_unref(pipeline);
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    // The plugin of this build, with a registry of its own (not the user's).
+    g_setenv("GST_PLUGIN_PATH", DEFOCUS_GST_PLUGIN_DIR, TRUE);
+    g_setenv("GST_REGISTRY", DEFOCUS_GST_PLUGIN_DIR "/registry.bin", TRUE);
+    gst_init(&argc, &argv);
+    ::testing::InitGoogleTest(&argc, argv);
+    return RUN_ALL_TESTS();
+}

@@ -1,0 +1,129 @@
+// defocus::Filter: gives one colour frame + its depth the depth of field of a real lens, with
+// hexagonal bokeh, on a headless OpenGL 4.5 context of its own (a GPU, or Mesa llvmpipe).
+//   defocus::Settings s;  s.lens.focusM = 1.0;  s.lens.fNumber = 1.4;
+//   defocus::Filter filter(s);                           // throws GlError without GL 4.5
+//   cv::Mat out = filter.process(bgr8, depth16);         // depth16 in s.depthScale units/metre
+//
+// Threads: a Filter is not thread-safe; call it from one thread at a time. Its EGL context is
+// made current on the thread that calls it (construction, process(), the destructor) and stays
+// current there until release(); before another thread uses the Filter, release() it on the
+// thread that used it last. Different Filters are independent and may run on different threads
+// at once. check(), version() and the settings structs are plain data and functions.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "defocus/Export.hpp"
+#include "defocus/Settings.hpp"
+
+namespace defocus {
+
+/// Every error the library throws; what() is one line that names the parameter or image.
+class DEFOCUS_API Error : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+/// A setting out of range, with the command line's message ("--f-number 0.5 is outside [0.7, 64]").
+class DEFOCUS_API SettingsError : public Error {
+public:
+    using Error::Error;
+};
+/// A colour or depth image of a type or size the filter cannot take.
+class DEFOCUS_API InputError : public Error {
+public:
+    using Error::Error;
+};
+/// No EGL display or OpenGL 4.5 context, or a driver that rejects a shader: says what was tried.
+class DEFOCUS_API GlError : public Error {
+public:
+    using Error::Error;
+};
+
+/// Where the time of one frame went, milliseconds.
+struct Timings {
+    double totalMs = 0.0;     ///< process(), wall clock
+    double depthPrepMs = 0.0; ///< depth resized to the colour and its holes filled (CPU)
+    double analysisMs = 0.0;  ///< scene analysis (GPU) and the plan (CPU)
+    double uploadMs = 0.0;    ///< colour and depth to the GPU
+    double renderMs = 0.0;    ///< submitting the passes
+    double readbackMs = 0.0;  ///< the output pass and reading the result back
+    struct Pass {
+        std::string name; ///< e.g. "coc", "rhombi-1", "rhombi-2", "upscale"
+        double ms = 0.0;  ///< GPU time
+    };
+    /// GPU time per pass of frame `gpuFrame`, read one frame late so that the GPU is never
+    /// waited for; empty on the first frame and where the driver has no timer queries.
+    std::vector<Pass> gpu;
+    std::size_t gpuFrame = 0;
+};
+
+/// What the frame called for and what ran (the command line's --explain).
+struct Plan {
+    bool allInFocus = false;          ///< no blur anywhere: the output is the input, no pass ran
+    std::size_t tiles = 0;            ///< tiles of the frame (SceneAnalysis' 16x16 pixels)
+    std::size_t blurTiles = 0;        ///< tiles the blur passes processed
+    std::size_t copyTiles = 0;        ///< tiles only copied (in focus)
+    bool holeFill = false;            ///< the depth had holes, filled from valid neighbours
+    double invalidDepthFraction = 0;  ///< share of the depth that had no measurement, [0, 1]
+    bool nearField = false;           ///< the foreground's own blur ran
+    bool highlightSprites = false;    ///< lights were scattered as hexagons
+    std::string explain;              ///< one line, as `defocus --explain` prints it
+};
+
+/// The last processed frame.
+struct FrameReport {
+    std::size_t index = 0; ///< frames since construction or reset(), from 0
+    double focusM = 0.0;   ///< focus distance used, metres (the autofocus' when it is on)
+    Timings timings;
+    Plan plan;
+};
+
+class DEFOCUS_API Filter {
+public:
+    /// Creates the EGL context (made current on this thread) and compiles the shaders: the
+    /// first Filter of a process takes a second or more on llvmpipe. Throws SettingsError for
+    /// settings out of range and GlError where no OpenGL 4.5 context can be made.
+    explicit Filter(const Settings& settings = {});
+    ~Filter();
+    Filter(Filter&&) noexcept;
+    Filter& operator=(Filter&&) noexcept;
+    Filter(const Filter&) = delete;
+    Filter& operator=(const Filter&) = delete;
+
+    /// Replaces the settings from the next process() on. Throws SettingsError (the settings
+    /// stay as they were) when any is out of range; check() with clamp first to accept anything.
+    void setSettings(const Settings& settings);
+    const Settings& settings() const;
+
+    /// Filters one frame and returns the result, the colour's size (Settings::output says
+    /// how it is encoded).
+    /// `color`: BGR, CV_8UC3 sRGB-encoded (CV_8UC4: the fourth channel is ignored) or CV_32FC3
+    /// scene-linear. `depth`: along the view axis, CV_16UC1 in Settings::depthScale units per
+    /// metre or CV_32FC1 metres; 0, NaN and infinities mean "no measurement" (filled from valid
+    /// neighbours); any size with the colour's aspect ratio (resized by nearest neighbour); empty
+    /// = all in focus. `timestampS`: capture time, seconds (AutofocusOptions::Mode::Follow steps by the time
+    /// between frames; 0 = unknown, taken as 1/30 s). Throws InputError for images it cannot
+    /// take and SettingsError when an automatic focus comes out of range.
+    cv::Mat process(const cv::Mat& color, const cv::Mat& depth, double timestampS = 0.0);
+
+    /// The last frame's timings and plan (valid after the first process()).
+    const FrameReport& lastFrame() const;
+    /// A new stream: the next frame is frame 0 again, and the autofocus measures afresh.
+    void reset();
+    /// Unbinds the EGL context from the calling thread, so that another thread can use the Filter.
+    void release();
+    /// The OpenGL renderer, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
+    std::string renderer() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace defocus

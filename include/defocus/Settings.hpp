@@ -1,0 +1,140 @@
+// The settings of defocus::Filter: the lens, how focus is chosen, the quality, what is written.
+// Each field has its unit, range and default; names and ranges are the defocus command line's
+// (`defocus --help`), so `--f-number 1.4` is `settings.lens.fNumber = 1.4`.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "defocus/Export.hpp"
+
+namespace defocus {
+
+/// The lens whose depth of field the filter gives the frames.
+struct Lens {
+    /// How depth becomes a blur diameter (circle of confusion, CoC). --coc-model
+    enum class Model {
+        ThinLens,  ///< "thin-lens": the physical lens of focal length, f-number and focus distance
+        FocalRange ///< "focal-range": blur rises linearly from focusM to maxCocPx at nearM and farM
+    };
+    /// Where sensorWidthMm spans the image (thin lens only). --fov-from
+    enum class FovFrom {
+        ImageDistance, ///< "image-distance": a real camera, whose view narrows as it focuses closer
+        FocalLength    ///< "focal-length": renderers (Blender Cycles, game engines)
+    };
+
+    /// Distance in focus, metres, (focal length, +inf]; +inf focuses at infinity. Default 2.
+    /// Not used while AutofocusOptions::mode is on. --focus
+    double focusM = 2.0;
+    /// Aperture as an f-number N (aperture diameter = focal length / N), [0.7, 64]. Default 2.
+    double fNumber = 2.0;
+    /// Focal length, millimetres, [1, 1200]. Default 50.
+    double focalLengthMm = 50.0;
+    /// Sensor width the image width spans, millimetres, [1, 100]. Default 36 (full frame).
+    double sensorWidthMm = 36.0;
+    /// Default ImageDistance.
+    FovFrom fovFrom = FovFrom::ImageDistance;
+    /// Largest blur diameter, pixels, [0, 512]; larger blur is clamped. Default 32.
+    double maxCocPx = 32.0;
+    /// Default ThinLens.
+    Model cocModel = Model::ThinLens;
+    /// FocalRange only: metres where blur in front of the focus reaches maxCocPx, [0, focus). Default 1.
+    double nearM = 1.0;
+    /// FocalRange only: metres where blur behind the focus reaches maxCocPx, (focus, +inf]. Default 6.
+    double farM = 6.0;
+    /// Hexagon rotation, degrees counter-clockwise, [-180, 180]; 0 = a corner on top (as
+    /// Blender Cycles), 30 = a flat top. Default 0.
+    double bladeRotationDeg = 0.0;
+};
+
+/// How the focus distance is chosen.
+struct AutofocusOptions {
+    enum class Mode {
+        /// Lens::focusM as given.
+        Off,
+        /// The command line's `--focus auto`: the median valid depth of the central 10 % (of
+        /// each axis) of the first frame after construction or reset(), then fixed.
+        FirstFrame,
+        /// The live preview's autofocus: the weighted mean of 1/depth over the central 10 %,
+        /// followed smoothly by a critically damped spring in dioptres (a step reaches 95 % of
+        /// its way in 4.7 time constants), with a dead band of 0.02 dioptres against sensor noise.
+        Follow
+    };
+    /// Default Off.
+    Mode mode = Mode::Off;
+    /// Follow: the spring's time constant, seconds, [0, 10]; 0 jumps at once. Default 0.25.
+    double timeConstantS = 0.25;
+};
+
+/// Speed against accuracy. A preset sets every field left empty; a field that is set overrides
+/// it, as the command line's flags override --quality.
+struct Quality {
+    /// --quality: from the accuracy benchmark (docs/accuracy.md); all use the rhombus kernel
+    /// with its near field and 32-bit float targets.
+    enum class Preset {
+        Fast,     ///< "fast": 4 taps per line, blurs at half size
+        Balanced, ///< "balanced": 6 taps, half size
+        High      ///< "high": 12 taps, full size
+    };
+    /// --hexagon: how the directional blurs make the hexagon.
+    enum class Hexagon {
+        Rhombi,  ///< "rhombi": three one-sided rhombi summed; keeps a highlight's energy
+        McIntosh ///< "mcintosh": McIntosh et al. 2012, the min() of two rhombi
+    };
+    /// --precision of the intermediate render targets.
+    enum class Precision { F16, F32 };
+    /// --resolution the blurs run at; the output always has the frame's size.
+    enum class Resolution { Full, Half };
+
+    /// Default Balanced.
+    Preset preset = Preset::Balanced;
+    /// Taps per directional blur, [2, 64]. Default: the preset's.
+    std::optional<int> samples;
+    /// Default: the preset's (Rhombi).
+    std::optional<Hexagon> hexagon;
+    /// Default: the preset's (F32).
+    std::optional<Precision> precision;
+    /// Default: the preset's.
+    std::optional<Resolution> resolution;
+    /// Spread blurred foreground over what is behind it. Default: the preset's (on).
+    std::optional<bool> nearField;
+    /// Rhombi: lights brighter than white scatter as hexagons with exact edges. Default on.
+    bool highlightSprites = true;
+    /// 8-bit input: near-clipped pixels that get blurred are scaled up to this, so lights bloom,
+    /// [1, 64]; 1 = off. Default 1.
+    double highlightGain = 1.0;
+    /// Run every pass on every pixel, ignoring the per-frame plan (for comparisons). Default off.
+    bool alwaysOn = false;
+};
+
+struct Settings {
+    /// --view: what the filter returns; the first five are the stages of the blur.
+    enum class View { Input, Horizontal, DiagonalA, DiagonalB, Composite, Depth, Coc };
+    /// How the result is returned.
+    enum class Output {
+        Srgb8,    ///< CV_8UC3 BGR, sRGB-encoded (what an 8-bit image or video holds)
+        Linear32F ///< CV_32FC3 BGR, scene-linear, unclipped (HDR kept)
+    };
+
+    Lens lens;
+    AutofocusOptions autofocus;
+    Quality quality;
+    /// Default Composite (the result).
+    View view = View::Composite;
+    /// Default Srgb8.
+    Output output = Output::Srgb8;
+    /// Units per metre of 16-bit depth images, > 0. Default 1000 (millimetres, most sensors);
+    /// TUM RGB-D uses 5000.
+    double depthScale = 1000.0;
+};
+
+/// Checks every field against its range, with the command line's words: each problem is one
+/// message such as "--f-number 0.5 is outside [0.7, 64]"; none means valid. With `clamp`, each
+/// value out of range is replaced by the nearest allowed one (the messages say what was wrong).
+DEFOCUS_API std::vector<std::string> check(Settings& settings, bool clamp = false);
+
+/// The library's version, "MAJOR.MINOR.PATCH".
+DEFOCUS_API std::string version();
+
+} // namespace defocus

@@ -1,0 +1,383 @@
+// libdefocus: the public API (include/defocus/) over the pipeline and its EGL context. The
+// settings are turned into the pipeline's exactly as the defocus command line turns its flags.
+#include "defocus/Filter.hpp"
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <utility>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "filter/Autofocus.hpp"
+#include "filter/DepthPrep.hpp"
+#include "filter/Pipeline.hpp"
+#include "filter/Settings.hpp"
+#include "filter/gl/EglContext.hpp"
+#include "filter/gl/Program.hpp"
+#include "filter/methods/Presets.hpp"
+
+#ifndef DEFOCUS_VERSION
+#error "DEFOCUS_VERSION is set by CMake from project(VERSION)"
+#endif
+
+namespace defocus {
+
+namespace {
+
+/// Seconds between frames when the timestamps do not say (the bundled clip's 30 Hz).
+constexpr double kFallbackFrameS = 1.0 / 30.0;
+/// The command line's `--focus auto`: median of the central 10 %, 2 m where it has no depth.
+constexpr double kAutoWindow = 0.1;
+constexpr float kAutoFallbackM = 2.0f;
+
+std::string_view presetName(Quality::Preset preset)
+{
+    switch (preset) {
+    case Quality::Preset::Fast: return "fast";
+    case Quality::Preset::High: return "high";
+    default: return "balanced";
+    }
+}
+
+LensSettings toLens(const Lens& lens)
+{
+    LensSettings out;
+    out.model = lens.cocModel == Lens::Model::FocalRange ? CocModel::FocalRange : CocModel::ThinLens;
+    out.focalLengthMm = lens.focalLengthMm;
+    out.fNumber = lens.fNumber;
+    out.focusM = lens.focusM;
+    out.sensorWidthMm = lens.sensorWidthMm;
+    out.fieldOfView = lens.fovFrom == Lens::FovFrom::FocalLength ? FieldOfView::FocalLength : FieldOfView::ImageDistance;
+    out.maxCocPx = lens.maxCocPx;
+    out.bladeRotationDeg = lens.bladeRotationDeg;
+    out.nearLimitM = lens.nearM;
+    out.farLimitM = lens.farM;
+    return out;
+}
+
+void fromLens(const LensSettings& in, Lens& lens)
+{
+    lens.focalLengthMm = in.focalLengthMm;
+    lens.fNumber = in.fNumber;
+    lens.focusM = in.focusM;
+    lens.sensorWidthMm = in.sensorWidthMm;
+    lens.maxCocPx = in.maxCocPx;
+    lens.bladeRotationDeg = in.bladeRotationDeg;
+    lens.nearM = in.nearLimitM;
+    lens.farM = in.farLimitM;
+}
+
+/// The preset's samples, precision, kernel, near field and resolution unless set, as the
+/// command line fills what its flags leave out; every other field as the command line's.
+QualitySettings toQuality(const Quality& quality)
+{
+    const QualitySettings preset = presetSettings(presetName(quality.preset));
+    QualitySettings out;
+    out.samples = quality.samples.value_or(preset.samples);
+    out.targetFormat = quality.precision ? (*quality.precision == Quality::Precision::F32 ? TargetFormat::Rgba32F
+                                                                                          : TargetFormat::Rgba16F)
+                                         : preset.targetFormat;
+    out.kernel = quality.hexagon ? (*quality.hexagon == Quality::Hexagon::McIntosh ? HexagonKernel::McIntoshMin
+                                                                                   : HexagonKernel::RhombiSum)
+                                 : preset.kernel;
+    out.nearField = quality.nearField.value_or(preset.nearField);
+    out.resolution = quality.resolution ? (*quality.resolution == Quality::Resolution::Half ? Resolution::Half
+                                                                                            : Resolution::Full)
+                                        : preset.resolution;
+    out.highlightSprites = quality.highlightSprites;
+    out.highlightGain = quality.highlightGain;
+    out.adaptive = !quality.alwaysOn;
+    return out;
+}
+
+View toView(Settings::View view)
+{
+    return kAllViews[static_cast<int>(view)];
+}
+
+template <typename T>
+void checkRange(std::vector<std::string>& issues, const char* parameter, T& value, T low, T high, bool clamp)
+{
+    if (value >= low && value <= high)
+        return;
+    issues.push_back(fmt::format("{} {} is outside [{}, {}]", parameter, value, low, high));
+    if (clamp)
+        value = std::isnan(static_cast<double>(value)) ? low : std::clamp(value, low, high);
+}
+
+const char* describeType(const cv::Mat& image)
+{
+    switch (image.type()) {
+    case CV_8UC1: return "8-bit, 1 channel";
+    case CV_8UC3: return "8-bit, 3 channels";
+    case CV_8UC4: return "8-bit, 4 channels";
+    case CV_16UC1: return "16-bit, 1 channel";
+    case CV_16UC3: return "16-bit, 3 channels";
+    case CV_32FC1: return "float, 1 channel";
+    case CV_32FC3: return "float, 3 channels";
+    case CV_32FC4: return "float, 4 channels";
+    default: return "of another type";
+    }
+}
+
+} // namespace
+
+std::vector<std::string> check(Settings& settings, bool clamp)
+{
+    // The lens and quality as the pipeline knows them, checked by the one validate() the
+    // command line uses; an automatic focus is checked once it is measured (as `--focus auto`).
+    LensSettings lens = toLens(settings.lens);
+    const bool autoFocus = settings.autofocus.mode != AutofocusOptions::Mode::Off;
+    const double givenFocus = lens.focusM;
+    if (autoFocus && !(lens.focusM > lens.focalLengthMm * 1e-3))
+        lens.focusM = lens.focalLengthMm * 2e-3;
+    std::vector<std::string> issues;
+    for (const auto& issue : validate(lens, clamp))
+        issues.push_back(issue.message);
+    if (autoFocus)
+        lens.focusM = givenFocus;
+    if (clamp)
+        fromLens(lens, settings.lens);
+
+    QualitySettings quality;
+    quality.samples = settings.quality.samples.value_or(quality.samples);
+    quality.highlightGain = settings.quality.highlightGain;
+    for (const auto& issue : validate(quality, clamp))
+        issues.push_back(issue.message);
+    if (clamp) {
+        if (settings.quality.samples)
+            settings.quality.samples = quality.samples;
+        settings.quality.highlightGain = quality.highlightGain;
+    }
+
+    checkRange(issues, "--autofocus-time-constant", settings.autofocus.timeConstantS, 0.0, 10.0, clamp);
+    if (!(settings.depthScale > 0.0) || !std::isfinite(settings.depthScale)) {
+        issues.push_back(fmt::format("--depth-scale {} must be a positive number of units per metre", settings.depthScale));
+        if (clamp)
+            settings.depthScale = 1000.0;
+    }
+    return issues;
+}
+
+std::string version()
+{
+    return DEFOCUS_VERSION;
+}
+
+struct Filter::Impl {
+    gl::EglContext context;
+    std::optional<Pipeline> pipeline; ///< destroyed first, with the context current
+    Settings settings;
+    LensSettings lens;
+    QualitySettings quality;
+    std::optional<Autofocus> follow;
+    bool focusChosen = false; ///< FirstFrame: the first frame's focus is measured
+    double firstFrameFocusM = 0.0;
+    double previousTimestamp = 0.0;
+    std::size_t frames = 0;
+    FrameReport report;
+
+    explicit Impl(gl::EglContext made) : context(std::move(made)) {}
+
+    void bind()
+    {
+        if (!context.isCurrent())
+            context.makeCurrent();
+    }
+
+    void apply(const Settings& next)
+    {
+        Settings checked = next;
+        if (const auto issues = check(checked); !issues.empty())
+            throw SettingsError(issues.front());
+        const bool followChanged = !follow || next.autofocus.mode != settings.autofocus.mode ||
+                                   next.autofocus.timeConstantS != settings.autofocus.timeConstantS;
+        settings = next;
+        lens = toLens(next.lens);
+        quality = toQuality(next.quality);
+        if (next.autofocus.mode != AutofocusOptions::Mode::Follow) {
+            follow.reset();
+        } else if (followChanged) {
+            // A new time constant keeps the focus where it is and goes on from there.
+            const double from = follow ? follow->focusM() : next.lens.focusM;
+            AutofocusSettings afSettings;
+            afSettings.timeConstantS = next.autofocus.timeConstantS;
+            const bool measured = follow.has_value();
+            follow.emplace(afSettings, std::isfinite(from) ? from : 1e6);
+            if (measured)
+                follow->setFocus(from);
+        }
+    }
+};
+
+Filter::Filter(const Settings& settings)
+{
+    Settings checked = settings;
+    if (const auto issues = check(checked); !issues.empty())
+        throw SettingsError(issues.front());
+    try {
+        impl_ = std::make_unique<Impl>(gl::EglContext::create());
+        impl_->pipeline.emplace();
+    } catch (const gl::ContextError& error) {
+        throw GlError(error.what());
+    } catch (const gl::ShaderError& error) {
+        throw GlError(error.what());
+    }
+    impl_->apply(settings);
+}
+
+Filter::~Filter()
+{
+    if (!impl_)
+        return;
+    // The pipeline's GL objects are deleted with the context current on this thread.
+    impl_->bind();
+    impl_->pipeline.reset();
+}
+
+Filter::Filter(Filter&&) noexcept = default;
+
+Filter& Filter::operator=(Filter&& other) noexcept
+{
+    if (this != &other) {
+        if (impl_) {
+            impl_->bind();
+            impl_->pipeline.reset();
+        }
+        impl_ = std::move(other.impl_);
+    }
+    return *this;
+}
+
+void Filter::setSettings(const Settings& settings)
+{
+    impl_->apply(settings);
+}
+
+const Settings& Filter::settings() const
+{
+    return impl_->settings;
+}
+
+cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+{
+    Impl& p = *impl_;
+    if (color.empty())
+        throw InputError("colour image is empty");
+    Frame frame;
+    switch (color.type()) {
+    case CV_8UC3:
+    case CV_32FC3: frame.color = color; break;
+    case CV_8UC4: cv::cvtColor(color, frame.color, cv::COLOR_BGRA2BGR); break;
+    default:
+        throw InputError(fmt::format("colour image is {}; expected BGR 8-bit (CV_8UC3, or CV_8UC4 whose fourth "
+                                     "channel is ignored) or float (CV_32FC3)",
+                                     describeType(color)));
+    }
+    if (!depth.empty()) {
+        if (depth.type() == CV_16UC1)
+            // As a 16-bit depth file is read: 0 (no measurement) stays 0.
+            depth.convertTo(frame.depth, CV_32F, 1.0 / p.settings.depthScale);
+        else if (depth.type() == CV_32FC1)
+            frame.depth = depth;
+        else
+            throw InputError(fmt::format("depth image is {}; expected 16-bit single-channel (CV_16UC1, {} units per "
+                                         "metre) or float metres (CV_32FC1)",
+                                         describeType(depth), p.settings.depthScale));
+        if (const std::string problem = depthFitProblem(color.size(), "colour", depth.size(), "depth");
+            !problem.empty())
+            throw InputError(problem);
+    }
+    frame.index = p.frames;
+    frame.timestamp = timestampS;
+    frame.name = fmt::format("frame {}", p.frames);
+
+    LensSettings lens = p.lens;
+    switch (p.settings.autofocus.mode) {
+    case AutofocusOptions::Mode::Off: break;
+    case AutofocusOptions::Mode::FirstFrame:
+        if (!p.focusChosen) {
+            p.firstFrameFocusM = centreDepth(frame.depth, kAutoWindow, kAutoFallbackM);
+            LensSettings measured = lens;
+            measured.focusM = p.firstFrameFocusM;
+            if (const auto issues = validate(measured); !issues.empty())
+                throw SettingsError(fmt::format("automatic focus: {}", issues.front().message));
+            p.focusChosen = true;
+        }
+        lens.focusM = p.firstFrameFocusM;
+        break;
+    case AutofocusOptions::Mode::Follow: {
+        const double dt = frameInterval(p.previousTimestamp, timestampS, kFallbackFrameS);
+        lens.focusM = frame.depth.empty() ? p.follow->advance(dt) : p.follow->update(frame.depth, dt);
+        // Nearer than the lens can focus: the nearest it can.
+        lens.focusM = std::max(lens.focusM, lens.focalLengthMm * 1e-3 * 1.01);
+        break;
+    }
+    }
+    p.previousTimestamp = timestampS;
+
+    p.bind();
+    const Encoding encoding =
+        p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
+    cv::Mat out = p.pipeline->run(frame, lens, p.quality, toView(p.settings.view), encoding);
+
+    const FrameTimings& t = p.pipeline->timings();
+    FrameReport& r = p.report;
+    r.index = p.frames++;
+    r.focusM = lens.focusM;
+    r.timings.totalMs = t.totalMs;
+    r.timings.depthPrepMs = t.depthPrepMs;
+    r.timings.analysisMs = t.analysisMs;
+    r.timings.uploadMs = t.uploadMs;
+    r.timings.renderMs = t.renderMs;
+    r.timings.readbackMs = t.readbackMs;
+    r.timings.gpu.clear();
+    for (const auto& pass : t.gpu)
+        r.timings.gpu.push_back({pass.name, pass.ms});
+    r.timings.gpuFrame = t.gpuFrame;
+    const FramePlan& plan = p.pipeline->plan();
+    const SceneAnalysis& analysis = p.pipeline->analysis();
+    r.plan.allInFocus = plan.allInFocus;
+    r.plan.tiles = static_cast<std::size_t>(analysis.tiles.area());
+    r.plan.blurTiles = plan.blurTiles.size();
+    r.plan.copyTiles = plan.copyTiles.size();
+    r.plan.holeFill = plan.holeFill;
+    r.plan.invalidDepthFraction = p.pipeline->invalidDepthFraction();
+    r.plan.nearField = plan.nearField;
+    r.plan.highlightSprites = plan.highlightSprites;
+    r.plan.explain = plan.explain(analysis);
+    return out;
+}
+
+const FrameReport& Filter::lastFrame() const
+{
+    return impl_->report;
+}
+
+void Filter::reset()
+{
+    Impl& p = *impl_;
+    p.frames = 0;
+    p.focusChosen = false;
+    p.previousTimestamp = 0.0;
+    p.report = {};
+    if (p.follow) {
+        AutofocusSettings afSettings;
+        afSettings.timeConstantS = p.settings.autofocus.timeConstantS;
+        p.follow.emplace(afSettings, std::isfinite(p.settings.lens.focusM) ? p.settings.lens.focusM : 1e6);
+    }
+}
+
+void Filter::release()
+{
+    impl_->context.release();
+}
+
+std::string Filter::renderer() const
+{
+    return impl_->context.info().glRenderer;
+}
+
+} // namespace defocus

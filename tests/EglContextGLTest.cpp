@@ -1,0 +1,44 @@
+// Several EGL contexts in one process: each lives and ends on its own.
+#include <epoxy/gl.h>
+#include <gtest/gtest.h>
+
+#include "filter/Pipeline.hpp"
+#include "filter/gl/EglContext.hpp"
+#include "tests/GLTestSupport.hpp"
+
+namespace defocus {
+namespace {
+
+using EglContexts = test::GLTest;
+
+// Defect caught: a context's end terminating the EGL display that every context of the process
+// shares (EGL displays are one per device), so that a second filter, or the library beside a
+// GStreamer element, renders garbage or fails once the first is gone.
+TEST_F(EglContexts, OneEndingLeavesTheOthersWorking)
+{
+    auto other = std::make_unique<gl::EglContext>(gl::EglContext::create());
+    other.reset();
+    context()->makeCurrent();
+    ASSERT_TRUE(context()->isCurrent());
+    cv::Mat color(48, 64, CV_8UC3, cv::Scalar(10, 120, 240)), depth(48, 64, CV_32F, cv::Scalar(2.0f));
+    Pipeline pipeline;
+    LensSettings lens;
+    lens.focusM = 2.0;
+    const cv::Mat out = pipeline.run({color, depth, 0.0, 0, "flat"}, lens, QualitySettings{});
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+    cv::Mat diff;
+    cv::absdiff(out, color, diff);
+    EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0) << "an in-focus flat frame comes back as it went in";
+}
+
+// Defect caught: a context that ends unbinding another one that is current on the same thread.
+TEST_F(EglContexts, EndingOneKeepsTheCurrentOneCurrent)
+{
+    auto other = std::make_unique<gl::EglContext>(gl::EglContext::create());
+    context()->makeCurrent();
+    other.reset();
+    EXPECT_TRUE(context()->isCurrent());
+}
+
+} // namespace
+} // namespace defocus

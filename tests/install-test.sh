@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs defocus into a temporary prefix, builds tests/consumer against it twice (CMake package,
+# then pkg-config) and checks that each consumer's PNG of one bundled frame is the same file, byte
+# for byte, as the command line's with the same settings.
+#   tests/install-test.sh BUILD_DIR DEFOCUS_CLI [PRESET]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=$1 cli=$2 preset=${3:-balanced}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+cmake --install "$build" --prefix "$work/prefix" >/dev/null
+# Frame 9 of the bundled clip (the README's picture) and its associated depth.
+read -r _ rgb _ depth < <(sed -n 9p "$root/data/tum_fr1_rpy/associations.txt")
+color=$root/data/tum_fr1_rpy/$rgb depth=$root/data/tum_fr1_rpy/$depth
+
+"$cli" "$color" --depth "$depth" --depth-scale 5000 --focus 1.0 --f-number 1.4 --quality "$preset" \
+  -o "$work/cli.png" -q >/dev/null
+
+status=0
+for mode in cmake pkg-config; do
+  flags=(-DCMAKE_PREFIX_PATH="$work/prefix")
+  [ "$mode" = pkg-config ] && flags=(-DUSE_PKG_CONFIG=ON)
+  PKG_CONFIG_PATH="$(dirname "$(find "$work/prefix" -name defocus.pc)")" \
+    cmake -S "$root/tests/consumer" -B "$work/build-$mode" -G Ninja -DCMAKE_BUILD_TYPE=Release "${flags[@]}" >/dev/null
+  cmake --build "$work/build-$mode" >/dev/null
+  # The installed library must be the one loaded, not the build tree's.
+  lib=$(ldd "$work/build-$mode/defocus-consumer" | awk '/libdefocus/ {print $3}')
+  case "$lib" in "$work/prefix/"*) ;; *) echo "install-test: $mode consumer loads '$lib', not the installed library"; exit 1 ;; esac
+  "$work/build-$mode/defocus-consumer" "$color" "$depth" 5000 1.0 1.4 "$preset" "$work/$mode.png"
+  if cmp -s "$work/cli.png" "$work/$mode.png"; then
+    echo "install-test: $mode consumer ($preset) = defocus CLI, byte for byte"
+  else
+    echo "install-test: $mode consumer ($preset) differs from the defocus CLI"
+    status=1
+  fi
+done
+exit $status
