@@ -229,4 +229,70 @@ ErrorReport measureError(const cv::Mat& image, const cv::Mat& truth, const cv::M
     return report;
 }
 
+std::string_view zoneName(Zone zone)
+{
+    switch (zone) {
+    case Zone::Lights: return "lights";
+    case Zone::DepthEdge: return "depth-edges";
+    case Zone::InFocus: return "in-focus";
+    case Zone::Near: return "near";
+    case Zone::Far: return "far";
+    }
+    return "?";
+}
+
+cv::Mat zoneMap(const cv::Mat& inputLinear, const cv::Mat& cocPx, const ZoneOptions& options)
+{
+    CV_Assert(inputLinear.type() == CV_32FC3 && cocPx.type() == CV_32FC1 && inputLinear.size() == cocPx.size());
+    // Distance of every pixel to the nearest light: distanceTransform measures the distance to
+    // the nearest zero, so lights are 0 and the rest 1.
+    cv::Mat notLight(inputLinear.size(), CV_8UC1);
+    for (int y = 0; y < inputLinear.rows; ++y) {
+        const float* in = inputLinear.ptr<float>(y);
+        uchar* o = notLight.ptr<uchar>(y);
+        for (int x = 0; x < inputLinear.cols; ++x)
+            o[x] = std::max({in[3 * x], in[3 * x + 1], in[3 * x + 2]}) > options.lightThreshold ? 0 : 1;
+    }
+    cv::Mat distance;
+    cv::distanceTransform(notLight, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    const cv::Mat regions = regionMap(cocPx, options.regions);
+    cv::Mat zones(inputLinear.size(), CV_8UC1);
+    for (int y = 0; y < zones.rows; ++y) {
+        const float* d = distance.ptr<float>(y);
+        const float* c = cocPx.ptr<float>(y);
+        const uchar* r = regions.ptr<uchar>(y);
+        uchar* z = zones.ptr<uchar>(y);
+        for (int x = 0; x < zones.cols; ++x) {
+            Zone zone = c[x] < 0.0f ? Zone::Near : Zone::Far;
+            if (d[x] <= options.lightRadiusPx)
+                zone = Zone::Lights;
+            else if (r[x] == static_cast<uchar>(Region::DepthEdge))
+                zone = Zone::DepthEdge;
+            else if (r[x] == static_cast<uchar>(Region::InFocus))
+                zone = Zone::InFocus;
+            z[x] = static_cast<uchar>(zone);
+        }
+    }
+    return zones;
+}
+
+ZoneReport measureZones(const cv::Mat& image, const cv::Mat& truth, const cv::Mat& zones)
+{
+    CV_Assert(zones.type() == CV_8UC1 && zones.size() == image.size());
+    ZoneReport report;
+    const cv::Mat a = clipped(image), b = clipped(truth);
+    const double total = static_cast<double>(zones.total());
+    const double totalError = maskedMse(a, b, {}) * total;
+    for (const Zone zone : kZones) {
+        const cv::Mat mask = zones == static_cast<int>(zone);
+        const auto i = static_cast<std::size_t>(zone);
+        const double mse = maskedMse(a, b, mask);
+        const double pixels = static_cast<double>(cv::countNonZero(mask));
+        report.psnr[i] = psnrFromMse(mse);
+        report.share[i] = pixels / total;
+        report.errorShare[i] = pixels == 0.0 || totalError == 0.0 ? 0.0 : mse * pixels / totalError;
+    }
+    return report;
+}
+
 } // namespace defocus

@@ -1,6 +1,7 @@
 // Error of a result against a ground truth (both CV_32FC3 linear BGR): PSNR of linear values
-// clipped to [0, 1], PSNR after sRGB encoding, SSIM on luma, and PSNR per region (in focus, out of
-// focus, depth edge) with the regions drawn from the thin-lens CoC map. CPU only, no GL.
+// clipped to [0, 1], PSNR after sRGB encoding, SSIM on luma, PSNR per region (in focus, out of
+// focus, depth edge) with the regions drawn from the thin-lens CoC map, and PSNR and share of the
+// squared error per zone (lights, depth edges, in focus, near, far). CPU only, no GL.
 #pragma once
 
 #include <array>
@@ -81,5 +82,42 @@ struct ErrorReport {
 /// Measures `image` against `truth` (both CV_32FC3 linear, same size) with the region labels
 /// `regions` from regionMap().
 ErrorReport measureError(const cv::Mat& image, const cv::Mat& truth, const cv::Mat& regions);
+
+/// The zones the corpus report splits the error into, to say where it comes from. Every pixel is
+/// in exactly one; the first that applies wins, in this order.
+enum class Zone : unsigned char {
+    Lights = 0,    ///< within ZoneOptions::lightRadiusPx of an input pixel brighter than white
+    DepthEdge = 1, ///< Region::DepthEdge of regionMap()
+    InFocus = 2,   ///< Region::InFocus
+    Near = 3,      ///< out of focus in front of the focus (CoC < 0)
+    Far = 4        ///< out of focus behind it (CoC > 0)
+};
+inline constexpr std::array<Zone, 5> kZones{Zone::Lights, Zone::DepthEdge, Zone::InFocus, Zone::Near, Zone::Far};
+std::string_view zoneName(Zone zone); ///< "lights", "depth-edges", "in-focus", "near", "far"
+
+struct ZoneOptions {
+    /// An input pixel whose largest linear channel exceeds this is a light, > 0. Above white,
+    /// a light's bokeh stays saturated where a filter spreads it too little, and spreads
+    /// energy a clipped display would not show where it spreads it too much.
+    float lightThreshold = 1.0f;
+    /// Pixels within this distance of a light belong to the lights zone, pixels, >= 0: 30 px
+    /// covers the bokeh of a light blurred up to a 60 px CoC.
+    float lightRadiusPx = 30.0f;
+    RegionOptions regions; ///< depth edges and focus, as regionMap()
+};
+
+/// Labels each pixel with its Zone (CV_8UC1) from the input colour (CV_32FC3 linear) and its
+/// signed CoC map (CV_32FC1, pixels), the same size.
+cv::Mat zoneMap(const cv::Mat& inputLinear, const cv::Mat& cocPx, const ZoneOptions& options = {});
+
+/// Error per zone of one result.
+struct ZoneReport {
+    std::array<double, 5> psnr{};       ///< dB, linear clipped, per Zone (NaN for an empty zone)
+    std::array<double, 5> share{};      ///< share of the pixels in each Zone
+    std::array<double, 5> errorShare{}; ///< share of the whole image's squared error in each Zone
+};
+
+/// Measures `image` against `truth` (CV_32FC3 linear, same size) per zone of `zones` (zoneMap()).
+ZoneReport measureZones(const cv::Mat& image, const cv::Mat& truth, const cv::Mat& zones);
 
 } // namespace defocus

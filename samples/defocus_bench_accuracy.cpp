@@ -5,6 +5,8 @@
 // contact sheet of crops. A benchmark, not a test; docs/accuracy.md shows its output.
 //   defocus-bench-accuracy                               (run from the repository root)
 //   defocus-bench-accuracy --runs 9 --out out/accuracy --methods mcintosh,riguer
+//   defocus-bench accuracy --scene data/blender_spheres --scene data/corpus   (presets on a corpus,
+//       per scene and per zone, min and median: samples/BenchCorpus.cpp)
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -36,6 +38,7 @@
 #include "filter/methods/Method.hpp"
 #include "filter/methods/Presets.hpp"
 #include "sources/ImageIO.hpp"
+#include "samples/BenchCorpus.hpp"
 #include "samples/BenchMachine.hpp"
 #include "sources/SyntheticScene.hpp"
 
@@ -802,12 +805,50 @@ int main(int argc, char** argv)
     std::vector<std::string> scenes{"blender", "synthetic"};
     for (const std::string& name : syntheticSceneNames())
         scenes.push_back("synthetic:" + name);
-    app.add_option("--scene", options.scene,
-                   "blender (--data, the Cycles truth) or synthetic[:NAME] (spheres or edges, rendered with a "
-                   "256-sample thin-lens truth; docs/synthetic.md)")
-        ->check(CLI::IsMember(scenes))
-        ->capture_default_str();
+    std::vector<std::string> sceneArgs;
+    CorpusOptions corpus;
+    app.add_option("--scene", sceneArgs,
+                   "blender (default: --data, the Cycles truth, every method and setting), synthetic[:NAME] "
+                   "(spheres or edges, rendered with a 256-sample thin-lens truth; docs/synthetic.md), or "
+                   "scene folders (scene.json) and corpus folders of them, repeatable: the presets on each, "
+                   "per zone, with the minimum and median (docs/accuracy.md)");
+    app.add_option("--anchors", corpus.anchors,
+                   "scene folders only: folder of other tools' outputs, ANCHORS/SCENE/{blender-defocus,"
+                   "gegl-lens-blur}.exr (scripts/corpus/anchors.sh), measured beside the presets");
+    std::string presetList;
+    app.add_option("--presets", presetList, "scene folders only: comma-separated presets to run (default: all)");
+    app.add_flag("--missing-ok", corpus.missingOk,
+                 "scene folders only: exit 77 (skipped) when a --scene folder does not exist");
     CLI11_PARSE(app, argc, argv);
+
+    std::string commandLine;
+    for (int i = 0; i < argc; ++i)
+        commandLine += (i ? " " : "") + std::string(argv[i]);
+    const auto named = [&](const std::string& s) {
+        return std::find(scenes.begin(), scenes.end(), s) != scenes.end();
+    };
+    if (!sceneArgs.empty() && std::none_of(sceneArgs.begin(), sceneArgs.end(), named)) {
+        corpus.scenes = sceneArgs;
+        std::stringstream presetNames(presetList);
+        for (std::string name; std::getline(presetNames, name, ',');)
+            if (!name.empty())
+                corpus.presets.push_back(name);
+        corpus.out = options.out;
+        corpus.saveOutputs = options.saveOutputs;
+        try {
+            return runCorpusAccuracy(corpus, commandLine);
+        } catch (const std::exception& error) {
+            fmt::print(stderr, "defocus-bench accuracy: error: {}\n", error.what());
+            return kFailure;
+        }
+    }
+    if (sceneArgs.size() > 1) {
+        fmt::print(stderr, "defocus-bench-accuracy: error: --scene {} runs alone; scene folders may be repeated\n",
+                   *std::find_if(sceneArgs.begin(), sceneArgs.end(), named));
+        return kUsage;
+    }
+    if (sceneArgs.size() == 1)
+        options.scene = sceneArgs.front();
 
     std::stringstream list(methods);
     for (std::string name; std::getline(list, name, ',');) {
@@ -819,9 +860,6 @@ int main(int argc, char** argv)
         }
         options.methods.push_back(name);
     }
-    std::string commandLine;
-    for (int i = 0; i < argc; ++i)
-        commandLine += (i ? " " : "") + std::string(argv[i]);
     try {
         return run(options, commandLine);
     } catch (const std::exception& error) {

@@ -1,5 +1,5 @@
 // The accuracy metrics checked analytically: PSNR of identical images and of a known MSE, SSIM of
-// identical images, and the region masks partitioning the image.
+// identical images, the region masks partitioning the image, and the zones of the corpus report.
 #include <cmath>
 #include <limits>
 
@@ -125,6 +125,74 @@ TEST(Metrics, CocMapFollowsTheLensModel)
     EXPECT_NEAR(coc.at<float>(0, 0), -46.6f, 0.1f);
     EXPECT_NEAR(coc.at<float>(0, 1), 0.0f, 1e-4f);
     EXPECT_NEAR(coc.at<float>(0, 2), 15.6f, 0.1f);
+}
+
+// Defect caught: a lights zone of the wrong reach (a radius or distance in the wrong unit, a
+// threshold that takes white itself for a light) or lights losing to the other zones.
+TEST(MetricsZones, LightsReachThirtyPixelsFromPixelsAboveWhite)
+{
+    cv::Mat input(120, 160, CV_32FC3, cv::Scalar::all(0.5));
+    input.at<cv::Vec3f>(60, 80) = cv::Vec3f(0.2f, 1.5f, 0.2f); // one channel above white
+    input.at<cv::Vec3f>(10, 10) = cv::Vec3f(1.0f, 1.0f, 1.0f); // white itself is no light
+    const cv::Mat coc(input.size(), CV_32FC1, cv::Scalar(5.0f)); // all far, no depth edge
+    const cv::Mat zones = zoneMap(input, coc);
+    const auto at = [&](int y, int x) { return static_cast<Zone>(zones.at<uchar>(y, x)); };
+    EXPECT_EQ(at(60, 80), Zone::Lights);
+    EXPECT_EQ(at(60, 110), Zone::Lights);  // 30 px right
+    EXPECT_EQ(at(60, 111), Zone::Far);     // 31 px
+    EXPECT_EQ(at(81, 101), Zone::Lights);  // 29.7 px diagonally
+    EXPECT_EQ(at(82, 102), Zone::Far);     // 31.1 px
+    EXPECT_EQ(at(10, 10), Zone::Far);
+}
+
+// Defect caught: near and far swapped (the CoC's sign), in-focus or depth-edge pixels counted
+// as near or far, or a pixel in two zones.
+TEST(MetricsZones, NearFarInFocusAndEdgesFromTheCoc)
+{
+    const cv::Mat input(60, 90, CV_32FC3, cv::Scalar::all(0.3));
+    cv::Mat coc(input.size(), CV_32FC1, cv::Scalar(0.0f));
+    coc.colRange(0, 30).setTo(-6.0f); // near
+    coc.colRange(60, 90).setTo(0.2f); // in focus, a smooth step from the middle's 0
+    coc.colRange(30, 60).setTo(0.0f);
+    coc.colRange(30, 60).rowRange(0, 30).setTo(0.5f);
+    cv::Mat far = coc.clone();
+    const cv::Mat zones = zoneMap(input, coc);
+    EXPECT_EQ(static_cast<Zone>(zones.at<uchar>(30, 5)), Zone::Near);
+    EXPECT_EQ(static_cast<Zone>(zones.at<uchar>(30, 30)), Zone::DepthEdge); // the -6 | 0 jump
+    EXPECT_EQ(static_cast<Zone>(zones.at<uchar>(30, 80)), Zone::InFocus);
+    far.setTo(8.0f);
+    EXPECT_EQ(static_cast<Zone>(zoneMap(input, far).at<uchar>(30, 45)), Zone::Far);
+    for (int y = 0; y < zones.rows; ++y)
+        for (int x = 0; x < zones.cols; ++x)
+            ASSERT_LE(zones.at<uchar>(y, x), static_cast<uchar>(Zone::Far));
+}
+
+// Defect caught: error shares that do not add up to the whole image's error (a zone's MSE
+// weighted by the wrong pixel count), or PSNR computed over the wrong zone.
+TEST(MetricsZones, ErrorSharesAddUpAndFollowTheError)
+{
+    cv::Mat input(80, 80, CV_32FC3, cv::Scalar::all(0.4));
+    input.at<cv::Vec3f>(10, 10) = cv::Vec3f(5.0f, 5.0f, 5.0f);
+    const cv::Mat coc(input.size(), CV_32FC1, cv::Scalar(4.0f));
+    const cv::Mat zones = zoneMap(input, coc);
+    cv::Mat truth = input.clone(), image = input.clone();
+    image.at<cv::Vec3f>(70, 70) += cv::Vec3f(0.1f, 0.1f, 0.1f); // far, outside the light's 30 px
+    image.at<cv::Vec3f>(20, 20) += cv::Vec3f(0.3f, 0.3f, 0.3f); // lights
+    const ZoneReport report = measureZones(image, truth, zones);
+    const auto lights = static_cast<std::size_t>(Zone::Lights), farZone = static_cast<std::size_t>(Zone::Far);
+    EXPECT_NEAR(report.errorShare[lights], 0.09 / 0.10, 1e-6);
+    EXPECT_NEAR(report.errorShare[farZone], 0.01 / 0.10, 1e-6);
+    double shares = 0.0, pixels = 0.0;
+    for (const Zone zone : kZones) {
+        shares += report.errorShare[static_cast<std::size_t>(zone)];
+        pixels += report.share[static_cast<std::size_t>(zone)];
+    }
+    EXPECT_NEAR(shares, 1.0, 1e-9);
+    EXPECT_NEAR(pixels, 1.0, 1e-9);
+    // The lights zone: the squared error 3 x 0.09 over its pixels' 3 channels.
+    const double lightPixels = report.share[lights] * 80 * 80;
+    EXPECT_NEAR(report.psnr[lights], psnrFromMse(0.09 / lightPixels), 1e-4); // 0.3f + 0.4f in float
+    EXPECT_TRUE(std::isnan(report.psnr[static_cast<std::size_t>(Zone::Near)]));
 }
 
 } // namespace

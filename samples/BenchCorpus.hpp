@@ -1,0 +1,27 @@
+// The accuracy benchmark over scene folders (`defocus-bench accuracy --scene DIR ...`): every
+// preset on every scene of a corpus, PSNR per scene and per zone (lights, depth edges, in focus,
+// near, far), the minimum and the median per preset, and the anchors (Blender's Defocus node,
+// GEGL's lens blur) where their outputs are given. docs/accuracy.md shows its output.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace defocus {
+
+struct CorpusOptions {
+    std::vector<std::string> scenes; ///< scene folders or corpus folders (findAccuracyScenes())
+    std::string out = "out/accuracy"; ///< corpus.json and corpus.csv go here
+    /// Folder of anchor outputs, ANCHORS/SCENE/NAME.exr (linear), measured like the presets;
+    /// empty: none. scripts/corpus/anchors.sh makes them.
+    std::string anchors;
+    bool missingOk = false;  ///< a --scene folder that does not exist: exit 77 (skipped), not 1
+    bool saveOutputs = false; ///< also every preset's result, OUT/outputs/SCENE/PRESET.exr
+    std::vector<std::string> presets; ///< names of the presets to run; empty: all
+};
+
+/// Exit status: 0 done, 1 runtime failure (a bad scene folder, GL, output), 77 skipped (a
+/// missing scene folder with missingOk). Results on stdout, one error line on stderr.
+int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLine);
+
+} // namespace defocus
