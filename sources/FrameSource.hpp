@@ -38,6 +38,13 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// A device that exists but is in use by another program (a camera another process captures
+/// from): trying again later may work, so the programs exit with 75 (ExitStatus.hpp), not 1.
+class DeviceBusy : public SourceError {
+public:
+    using SourceError::SourceError;
+};
+
 class FrameSource {
 public:
     virtual ~FrameSource() = default;
