@@ -30,9 +30,11 @@
 #include "filter/gl/Program.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
+#include "samples/FocusSchedule.hpp"
 #include "samples/Progress.hpp"
 #include "sinks/FrameSink.hpp"
 #include "sinks/ImageSinks.hpp"
+#include "sources/DepthScale.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/SyntheticSource.hpp"
 
@@ -57,7 +59,12 @@ struct Options {
     std::string view = "composite";
     std::string contactSheet;
     std::size_t contactFrame = 0;
-    std::optional<std::size_t> frames;
+    std::optional<std::size_t> frames; ///< frames out at most
+    std::size_t start = 0;             ///< input frames skipped first
+    std::size_t every = 1;             ///< then every Nth input frame
+    std::string focusPoint;            ///< --focus-point X,Y; "" = the centre
+    AutofocusSettings autofocus;       ///< --focus track: --tau
+    double depthScaleUsed = 0.0;       ///< the scale the input is read at (for the plausibility check)
     std::optional<double> fps;
     std::string timings;
     bool explain = false;
@@ -194,6 +201,17 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     Progress progress(total, !options.quiet);
 
     LensSettings lens = options.lens;
+    std::optional<cv::Point2d> point;
+    if (!options.focusPoint.empty())
+        point = parsePoint(options.focusPoint); // checked by finishOptions
+    FocusControl focus(options.focus, point, options.autofocus);
+    if (!options.quiet && !demo)
+        spdlog::info("focus: {}", focus.describe());
+    const double fps = source.frameRate() > 0.0 ? source.frameRate() : 30.0;
+    std::optional<double> firstTimestamp;
+    double previousTimestamp = 0.0;
+    std::size_t read = 0;         // input frames read, selected or not
+    bool depthChecked = false;
     TimingLog timingLog;
     cv::Size frameSize;
     std::map<std::string, double> passMs;
@@ -208,16 +226,37 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
             std::optional<Frame> frame = source.next();
             if (!frame)
                 break;
+            const std::size_t position = read++;
+            if (!firstTimestamp)
+                firstTimestamp = frame->timestamp;
+            if (position < options.start || (position - options.start) % options.every != 0)
+                continue; // --start, --every
             ++framesIn;
+            if (!depthChecked && !demo && options.depthScaleUsed > 0.0) {
+                const DepthScaleCheck check = checkDepthScale(frame->depth, options.depthScaleUsed, frame->name);
+                depthChecked = check.validPixels > 0;
+                if (!check.warning.empty())
+                    spdlog::warn("{}", check.warning);
+            }
+            // Seconds since the clip's first frame, for focus keys: its timestamps when it has
+            // them, else the frame's index at the frame rate.
+            const bool stamped = *firstTimestamp > 0.0 && frame->timestamp > 0.0;
+            const double timeS = stamped ? frame->timestamp - *firstTimestamp : static_cast<double>(frame->index) / fps;
+            const double dtS = frameInterval(previousTimestamp, frame->timestamp, static_cast<double>(options.every) / fps);
+            previousTimestamp = frame->timestamp;
             if (demo && options.focus == "auto") {
                 lens.focusM = demo->lensAt(frame->index).focusM; // the scene's focus pull
-            } else if (framesIn == 1 && options.focus == "auto") {
-                lens.focusM = centreDepth(frame->depth, 0.1, 2.0f);
-                if (!options.quiet)
-                    spdlog::info("focus: auto -> {:.2f} m (median depth of the centre of {})", lens.focusM, frame->name);
+            } else if (!focus.isFixed()) {
+                lens.focusM = focus.focusFor(*frame, timeS, dtS);
+                if (framesIn == 1 && options.focus == "auto" && !options.quiet)
+                    spdlog::info("focus: auto -> {:.2f} m (median depth around {} of {})", lens.focusM,
+                                 point ? options.focusPoint : std::string("the centre"), frame->name);
                 if (const auto issues = validate(lens); !issues.empty())
-                    throw std::runtime_error(fmt::format("automatic focus: {}", issues.front().message));
+                    throw std::runtime_error(fmt::format("focus {:.3f} m at frame {}: {}", lens.focusM, frame->index,
+                                                         issues.front().message));
             }
+            if (options.explain)
+                std::printf("frame %zu: focus %.4f m\n", frame->index, lens.focusM);
             const cv::Mat image = pipeline.run(*frame, lens, options.quality, view, encoding);
             if (!options.contactSheet.empty() && frame->index == options.contactFrame) {
                 std::vector<std::pair<std::string, cv::Mat>> tiles;
@@ -282,7 +321,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
 /// One clip, from INPUT (or --demo) to -o OUTPUT: opens the input, the GL session when `gl` holds
 /// none yet (so a bad input is reported before GL is needed), the output, and runs processClip.
 /// Throws for an input, output or GL that cannot be opened (cli::statusFor gives the status).
-int runClip(const Options& options, std::optional<GlSession>& gl)
+int runClip(Options options, std::optional<GlSession>& gl)
 {
     // Outputs besides the main one are checked before any frame is processed.
     if (!options.contactSheet.empty())
@@ -304,6 +343,7 @@ int runClip(const Options& options, std::optional<GlSession>& gl)
         if (!options.depth.empty())
             sourceOptions.depth = options.depth;
         source = openSource(sourceOptions);
+        options.depthScaleUsed = options.depthScale.value_or(defaultDepthScale(sourceOptions));
     }
 
     if (!gl)
@@ -334,8 +374,9 @@ void declareOptions(CLI::App& app, Options& o)
                    "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
         ->check(CLI::PositiveNumber);
     app.add_option("--focus", o.focus,
-                   "Distance in focus, metres; 'inf' for infinity; 'auto' = median depth of the centre of the "
-                   "first frame")
+                   "Distance in focus, metres; 'inf' for infinity; 'auto' = median depth of the centre (or "
+                   "--focus-point) of the first frame; 'track' = follow it frame by frame (the preview's "
+                   "autofocus, --tau); keys such as 0s:1.2,2s:3.5 = a focus pull, eased in dioptres")
         ->capture_default_str();
     app.add_option("--f-number", o.lens.fNumber, "Aperture as an f-number N (smaller = more blur), 0.7..64")
         ->capture_default_str();
@@ -383,7 +424,17 @@ void declareOptions(CLI::App& app, Options& o)
         ->capture_default_str();
     app.add_option("--contact-sheet", o.contactSheet, "Also write every view of one frame, labelled, to this PNG");
     app.add_option("--contact-frame", o.contactFrame, "Frame index for --contact-sheet")->capture_default_str();
-    app.add_option("--frames", o.frames, "Stop after this many frames")->check(CLI::PositiveNumber);
+    app.add_option("--frames", o.frames, "Stop after this many frames out")->check(CLI::PositiveNumber);
+    app.add_option("--start", o.start, "Skip this many input frames first")->capture_default_str();
+    app.add_option("--every", o.every, "Then take every Nth input frame (2 = every other)")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--focus-point", o.focusPoint,
+                   "X,Y: measure the focus at this pixel (the median of the valid depths in a window around it) "
+                   "instead of the centre; with --focus auto or track");
+    app.add_option("--tau", o.autofocus.timeConstantS, "--focus track: time constant, seconds (critically damped), >= 0")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     app.add_option("--fps", o.fps, "Frame rate of a video output, Hz [default: the input's]")->check(CLI::PositiveNumber);
     app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
     app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
@@ -447,9 +498,19 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
     o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
     parseKernel(o.kernel, o.quality.kernel);
     parseResolution(o.resolution, o.quality.resolution);
-    bool autoFocus = false;
-    if (!parseFocus(o.focus, o.lens, autoFocus)) {
-        spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);
+    try {
+        std::optional<cv::Point2d> point;
+        if (!o.focusPoint.empty())
+            point = parsePoint(o.focusPoint);
+        FocusControl check(o.focus, point, o.autofocus);
+    } catch (const std::invalid_argument& error) {
+        spdlog::error("{}", error.what());
+        return kExitUsage;
+    }
+    bool autoFocus = true; // auto, track and keys are checked frame by frame
+    if (o.focus != "auto" && o.focus != "track" && !FocusSchedule::isKeyed(o.focus) &&
+        !parseFocus(o.focus, o.lens, autoFocus)) {
+        spdlog::error("--focus '{}' is not metres, 'inf', 'auto', 'track' or keys", o.focus);
         return kExitUsage;
     }
     const auto issues = validateCommandLine(o.lens, o.quality, autoFocus);

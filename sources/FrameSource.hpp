@@ -80,6 +80,11 @@ struct SourceOptions {
     double fps = 30.0;
 };
 
+/// The units per metre openSource reads 16-bit depth at when `options.depthScale` is unset: 5000
+/// (TUM's) for a folder in the TUM layout and for a depth list (.txt), 1000 (millimetres) for
+/// everything else. README "Depth scales" says why the TUM layout keeps 5000.
+double defaultDepthScale(const SourceOptions& options);
+
 /// Opens the source that `options.input` names; throws SourceError with a clear message when
 /// it does not exist or cannot be recognised.
 std::unique_ptr<FrameSource> openSource(const SourceOptions& options);
