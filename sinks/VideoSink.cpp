@@ -38,7 +38,8 @@ struct Codec {
 };
 
 // avc1 is H.264 through FFmpeg's libx264 (Debian's FFmpeg has it); FFV1 is FFmpeg's lossless
-// intra codec; VP90 is libvpx's VP9.
+// intra codec; VP90 is libvpx's VP9 (OpenCV's FFmpeg wrapper prints that it maps the tag for
+// WebM, then writes VP9: a line on stderr it prints itself).
 const std::vector<Codec> kCodecs{{"h264", "avc1"}, {"mp4v", "mp4v"}, {"ffv1", "FFV1"}, {"vp9", "VP90"}, {"mjpg", "MJPG"}};
 
 // The container's default first, then what it falls back to when that encoder is missing.
