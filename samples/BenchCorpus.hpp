@@ -20,8 +20,9 @@ struct CorpusOptions {
     std::vector<std::string> presets; ///< names of the presets to run; empty: all
 };
 
-/// Exit status: 0 done, 1 runtime failure (a bad scene folder, GL, output), 77 skipped (a
-/// missing scene folder with missingOk). Results on stdout, one error line on stderr.
+/// Exit status: 0 done, 1 runtime failure (a bad scene folder, output), 77 skipped (a
+/// missing scene folder with missingOk); errors it throws the caller maps (75 for no GL). Results on
+/// stdout, one error line on stderr.
 int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLine);
 
 } // namespace defocus

@@ -28,7 +28,7 @@ TEST(BenchAccuracy, SpheresSceneFolderReproducesThePresetsFigures)
     const fs::path out = test::scratchDir("bench_accuracy");
     const fs::path binary = fs::path(DEFOCUS_BINARY_DIR) / "defocus-bench-accuracy";
     ASSERT_TRUE(fs::exists(binary)) << binary << " is missing: build the 'defocus-bench-accuracy' target first";
-    const std::string command = fmt::format("'{}' --scene '{}/blender_spheres' --presets balanced,high --out '{}' 2>&1",
+    const std::string command = fmt::format("'{}' --scene '{}/blender_spheres' --presets balanced,high --output '{}' 2>&1",
                                             binary.string(), DEFOCUS_DATA_DIR, out.string());
     FILE* pipe = ::popen(command.c_str(), "r");
     ASSERT_NE(pipe, nullptr);
