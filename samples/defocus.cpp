@@ -217,6 +217,7 @@ int run(const Options& options)
     std::map<std::string, double> passMs;
     double totalMs = 0, uploadMs = 0, readbackMs = 0;
     std::size_t framesIn = 0, timed = 0;
+    bool sheetWritten = false;
     std::size_t current = 0; // index of the frame being read or processed, for messages
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
@@ -249,6 +250,7 @@ int run(const Options& options)
                 if (!cv::imwrite(options.contactSheet, contactSheet(tiles)))
                     throw SinkError(fmt::format("cannot write contact sheet '{}'", options.contactSheet));
                 pipeline.run(*frame, lens, options.quality, view, encoding); // keep timings of a plain frame
+                sheetWritten = true;
             }
             sink->write(image);
             frameSize = image.size();
@@ -279,6 +281,9 @@ int run(const Options& options)
         passMs[pass.name] += pass.ms;
     if (!options.timings.empty())
         timingLog.write(options.timings, context.info().glRenderer, frameSize);
+    if (!options.contactSheet.empty() && !sheetWritten && exitCode == kOk && !gStop)
+        spdlog::warn("--contact-frame {} is beyond the {} frames read: no contact sheet written to {}",
+                     options.contactFrame, framesIn, options.contactSheet);
     if (gStop) {
         spdlog::warn("stopped by signal after {} frames; {} is finalised", framesIn, options.output);
         exitCode = kInterrupted;
