@@ -21,6 +21,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"
@@ -57,7 +58,8 @@ protected:
     static void SetUpTestSuite()
     {
         GLTest::SetUpTestSuite();
-        dir_ = test::scratchDir("cli_flags");
+        // One folder per process: CTest runs each test in a process of its own, side by side.
+        dir_ = test::scratchDir(fmt::format("cli_flags/{}", ::getpid()));
         std::vector<fs::path> rgb;
         for (const auto& e : fs::directory_iterator(test::dataDir() / "tum_fr1_rpy" / "rgb"))
             rgb.push_back(e.path());
@@ -98,6 +100,12 @@ protected:
         cv::imwrite((dir_ / "clip" / "rgb" / "1.png").string(), flipped);
         cv::imwrite((dir_ / "clip" / "depth" / "0.png").string(), planes(600, 3000));
         cv::imwrite((dir_ / "clip" / "depth" / "1.png").string(), planes(600, 3000));
+    }
+
+    static void TearDownTestSuite()
+    {
+        if (::testing::UnitTest::GetInstance()->failed_test_count() == 0)
+            fs::remove_all(dir_); // kept when something failed, to look at
     }
 
     static fs::path file(const std::string& name) { return dir_ / name; }
