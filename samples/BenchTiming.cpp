@@ -20,6 +20,7 @@
 #include "filter/methods/Presets.hpp"
 #include "filter/passes/CalibrationPass.hpp"
 #include "samples/BenchMachine.hpp"
+#include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
 
 namespace defocus {
@@ -114,7 +115,7 @@ int runTimingComparison(const TimingOptions& options)
     if (!std::filesystem::exists(options.data)) {
         std::fprintf(stderr, "defocus-bench timing: data '%s' not found (run from the repository root or pass --data)\n",
                      options.data.c_str());
-        return 2;
+        return kExitBadInput;
     }
     nlohmann::json baseline;
     if (!options.baseline.empty()) {
@@ -128,13 +129,13 @@ int runTimingComparison(const TimingOptions& options)
         } catch (const std::exception& error) {
             std::fprintf(stderr, "defocus-bench timing: cannot read baseline '%s': %s\n", options.baseline.c_str(),
                          error.what());
-            return 2;
+            return kExitBadInput;
         }
     }
     auto context = gl::EglContext::create();
     if (!context.info().timerQueries) {
         std::fprintf(stderr, "defocus-bench timing: %s has no GPU timer queries\n", context.info().glRenderer.c_str());
-        return 2;
+        return kExitUnavailable;
     }
     auto source = openSource({options.data, std::nullopt, std::nullopt});
     std::vector<Frame> frames;
@@ -143,7 +144,7 @@ int runTimingComparison(const TimingOptions& options)
             frames.push_back(std::move(*frame));
     if (frames.empty()) {
         std::fprintf(stderr, "defocus-bench timing: '%s' gave no frames\n", options.data.c_str());
-        return 2;
+        return kExitBadInput;
     }
 
     LensSettings lens;

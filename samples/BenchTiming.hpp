@@ -27,7 +27,8 @@ struct TimingOptions {
     double maxCocPx = 32.0;
 };
 
-/// Returns the process exit code: 0 within bounds, 1 regression, 2 bad input.
+/// Returns the exit status (samples/ExitStatus.hpp): 0 within bounds, 1 a failed comparison (the
+/// reasons printed) or an input that cannot be read, 75 no GPU timer queries.
 int runTimingComparison(const TimingOptions& options);
 
 } // namespace defocus
