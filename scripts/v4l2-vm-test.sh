@@ -171,15 +171,17 @@ mkdir -p /dev/shm/out
 "$1" /dev/video0 -o /dev/shm/out/ >/dev/shm/cli.log 2>&1 &
 pid=$!
 n=0
-while [ "$(ls /dev/shm/out | wc -l)" -lt 2 ] && [ $n -lt 1500 ]; do sleep 0.2; n=$((n + 1)); done
+# Frames are PNGs at the top of the folder (depth/ and the TUM lists beside them).
+frames() { ls /dev/shm/out/*.png 2>/dev/null | wc -l; }
+while [ "$(frames)" -lt 2 ] && [ $n -lt 1500 ]; do sleep 0.2; n=$((n + 1)); done
 v4l2-ctl -d /dev/video0 -c disconnect=1
 wait $pid
 status=$?
 tr '\r' '\n' </dev/shm/cli.log | grep -v '^frame' | sed 's/^/  /'
 complete=0
 for f in /dev/shm/out/*.png; do tail -c 12 "$f" | grep -q IEND && complete=$((complete + 1)); done
-echo "  defocus exit $status; $(ls /dev/shm/out | wc -l) frames kept, $complete of them complete PNGs"
-[ $status = 1 ] && [ $complete -ge 2 ] && [ $complete = "$(ls /dev/shm/out | wc -l)" ] &&
+echo "  defocus exit $status; $(frames) frames kept, $complete of them complete PNGs"
+[ $status = 1 ] && [ $complete -ge 2 ] && [ $complete = "$(frames)" ] &&
   grep -q 'disconnected after' /dev/shm/cli.log
 EOS
   run /bin/sh /dev/shm/cli.sh "$cli" || rc=1
