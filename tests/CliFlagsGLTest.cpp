@@ -334,7 +334,7 @@ TEST_F(CliFlags, QualityPresetsAndTheOptionsThatOverrideThem)
                           texture("near_far.png", lens + "--samples 12")));
 
     const auto plan = [&](const std::string& options) {
-        const Ran run = defocus(fmt::format("'{}' --depth '{}' --focus 1 {} --explain -q -o '{}' {}",
+        const Ran run = defocus(fmt::format("'{}' --depth '{}' --focus 1 {} --explain -q -y -o '{}' {}",
                                             file("colour.png").string(), file("near_focus.png").string(), lens,
                                             file("explain.png").string(), options));
         EXPECT_EQ(run.exitCode, 0) << run.err;
@@ -630,22 +630,22 @@ TEST_F(CliFlags, CodecAndImageFormatChooseWhatIsWritten)
                            static_cast<char>(code >> 16 & 0xff), static_cast<char>(code >> 24 & 0xff)};
     };
     EXPECT_EQ(fourcc("default.mkv", ""), "FFV1");
-    EXPECT_EQ(fourcc("mjpg.mkv", "--codec mjpg"), "MJPG");
+    const std::string mjpg = fourcc("mjpg.mkv", "--codec mjpg"); // Matroska tags it "mjpe" or "MJPG"
+    EXPECT_TRUE(mjpg == "MJPG" || mjpg == "mjpe") << mjpg;
 
     const auto written = [&](const std::string& name, const std::string& option) {
         const fs::path out = file(name);
         const Ran r = defocus(clip + " -o '" + out.string() + "/' " + option);
         EXPECT_EQ(r.exitCode, 0) << r.err;
         std::set<std::string> extensions;
-        for (const auto& e : fs::recursive_directory_iterator(out))
-            if (e.is_regular_file())
+        // The frames: the files at the top of the folder but the TUM lists (depth/ has its own).
+        for (const auto& e : fs::directory_iterator(out))
+            if (e.is_regular_file() && e.path().extension() != ".txt")
                 extensions.insert(e.path().extension().string());
         return extensions;
     };
     EXPECT_EQ(written("png_frames", ""), std::set<std::string>{".png"});
-    const auto exr = written("exr_frames", "--image-format exr");
-    EXPECT_TRUE(exr.count(".exr")) << exr.size();
-    EXPECT_FALSE(exr.count(".png"));
+    EXPECT_EQ(written("exr_frames", "--image-format exr"), std::set<std::string>{".exr"});
 }
 
 // --- the program itself ------------------------------------------------------------------------
@@ -662,7 +662,7 @@ TEST_F(CliFlags, InfoPrintsThePlatformAndExits)
 // Defects: -q printing the log, -v not adding the debug lines, --version not the version.
 TEST_F(CliFlags, QuietVerboseAndVersion)
 {
-    const std::string args = fmt::format("'{}' --depth '{}' --focus 1 -o '{}'", file("colour.png").string(),
+    const std::string args = fmt::format("'{}' --depth '{}' --focus 1 -y -o '{}'", file("colour.png").string(),
                                          file("far.png").string(), file("logged.png").string());
     const Ran plain = defocus(args), quiet = defocus(args + " -q"), verbose = defocus(args + " -v");
     EXPECT_NE((plain.err + plain.out).find("info:"), std::string::npos) << plain.err;
