@@ -26,8 +26,10 @@
 #include "filter/Views.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
+#include "samples/NewestFrameSource.hpp"
 #include "samples/Progress.hpp"
 #include "sinks/FrameSink.hpp"
+#include "sinks/V4l2OutputSink.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/SyntheticSource.hpp"
 
@@ -199,6 +201,13 @@ int run(const Options& options)
     SinkOptions sinkOptions{options.output, options.fps.value_or(source->frameRate() > 0 ? source->frameRate() : 30.0),
                             false};
     auto sink = openSink(sinkOptions);
+    // A camera to a virtual camera: never make the camera wait, drop what the filter cannot keep up with.
+    NewestFrameSource* newest = nullptr;
+    if (source->isLive() && dynamic_cast<V4l2OutputSink*>(sink.get())) {
+        auto feed = std::make_unique<NewestFrameSource>(std::move(source), gStop);
+        newest = feed.get();
+        source = std::move(feed);
+    }
 
     auto context = demoContext ? std::move(*demoContext) : gl::EglContext::create();
     Pipeline pipeline;
@@ -290,6 +299,9 @@ int run(const Options& options)
     std::puts(summarise(framesIn, sink->framesWritten(), passMs, totalMs, uploadMs, readbackMs, timed).c_str());
     if (!options.quiet)
         spdlog::info("wrote {}", sink->describe());
+    if (newest && !options.quiet)
+        spdlog::info("live: {} frames captured, {} dropped (the filter was slower than the camera)",
+                     newest->captured(), newest->dropped());
     return exitCode;
 }
 

@@ -2,6 +2,7 @@
 //   -o out/        numbered PNG sequence (EXR when the output is linear HDR)
 //   -o out.mp4     video (.mp4, .mkv, .avi) through cv::VideoWriter
 //   -o out.png     a single frame (the last one written wins); -o out.exr the same, linear float
+//   -o /dev/video10  a virtual camera (v4l2loopback), YUYV
 #pragma once
 
 #include <filesystem>
@@ -48,7 +49,8 @@ struct SinkOptions {
 };
 
 /// Picks the sink from the output path: a trailing '/' or an existing directory -> sequence;
-/// .mp4/.mkv/.avi -> video; .png/.jpg -> single 8-bit frame; .exr -> single linear frame.
+/// .mp4/.mkv/.avi -> video; .png/.jpg -> single 8-bit frame; .exr -> single linear frame;
+/// /dev/video* -> a V4L2 output device (V4l2OutputSink.hpp).
 /// Throws SinkError for an unknown extension or a file that cannot be created.
 std::unique_ptr<FrameSink> openSink(const SinkOptions& options);
 
