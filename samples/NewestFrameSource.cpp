@@ -6,8 +6,8 @@
 
 namespace defocus {
 
-NewestFrameSource::NewestFrameSource(std::unique_ptr<FrameSource> source, const std::atomic<bool>& stop)
-    : source_(std::move(source)), feed_(*source_, true), stop_(stop)
+NewestFrameSource::NewestFrameSource(std::unique_ptr<FrameSource> source, std::function<bool()> stopRequested)
+    : source_(std::move(source)), feed_(*source_, true), stopRequested_(std::move(stopRequested))
 {
 }
 
@@ -18,7 +18,7 @@ NewestFrameSource::~NewestFrameSource()
 
 std::optional<Frame> NewestFrameSource::next()
 {
-    while (!stop_) {
+    while (!stopRequested_()) {
         // Short waits, so that a stop request is seen even while the camera is silent.
         if (std::optional<FedFrame> fed = feed_.next(std::chrono::milliseconds(100)))
             return std::move(fed->frame);

@@ -4,8 +4,8 @@
 // a virtual camera (-o /dev/videoN), as the preview does.
 #pragma once
 
-#include <atomic>
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,12 +18,12 @@ namespace defocus {
 class NewestFrameSource final : public FrameSource {
 public:
     /// Starts capturing from `source` (which must be live) at once. next() gives up, returning
-    /// nullopt, once `stop` is set.
-    NewestFrameSource(std::unique_ptr<FrameSource> source, const std::atomic<bool>& stop);
+    /// nullopt, once `stopRequested` returns true (checked every 100 ms while waiting).
+    NewestFrameSource(std::unique_ptr<FrameSource> source, std::function<bool()> stopRequested);
     ~NewestFrameSource() override;
 
-    /// The newest frame not yet taken, waiting for one; nullopt when the stream ended or `stop`
-    /// was set. Rethrows the source's error.
+    /// The newest frame not yet taken, waiting for one; nullopt when the stream ended or a stop
+    /// was requested. Rethrows the source's error.
     std::optional<Frame> next() override;
     double frameRate() const override { return source_->frameRate(); }
     std::string describe() const override { return source_->describe(); }
@@ -36,7 +36,7 @@ public:
 private:
     std::unique_ptr<FrameSource> source_; // outlives feed_, whose thread reads it
     FrameFeed feed_;
-    const std::atomic<bool>& stop_;
+    std::function<bool()> stopRequested_;
 };
 
 } // namespace defocus

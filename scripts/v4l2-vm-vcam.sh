@@ -21,7 +21,16 @@ t=$(now)
 if ! "$build/defocus" "${in[@]}" "${lens[@]}" -q -o $ref/ >/dev/shm/vcam-ref.log 2>&1; then
   say "the reference run failed:"; sed 's/^/    /' /dev/shm/vcam-ref.log; exit 1
 fi
-say "reference: $(ls $ref | wc -l) PNGs ($t -> $(now) s)"
+# The command line's sequence keeps the input's frame names (listed in rgb.txt): the reader takes
+# a folder of them alone, in order.
+mkdir -p $ref-frames
+n=0
+while read -r _ file; do
+  ln -sf "$ref/$file" "$ref-frames/$(printf %06d $n).png"
+  n=$((n + 1))
+done < <(grep -v '^#' $ref/rgb.txt)
+say "reference: $n PNGs ($t -> $(now) s)"
+ref=$ref-frames
 
 # 1. defocus -o /dev/video4
 if [ "$gst" != only ]; then
