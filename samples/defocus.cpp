@@ -31,9 +31,11 @@
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
 #include "samples/FocusSchedule.hpp"
+#include "samples/NewestFrameSource.hpp"
 #include "samples/Progress.hpp"
 #include "sinks/FrameSink.hpp"
 #include "sinks/ImageSinks.hpp"
+#include "sinks/V4l2OutputSink.hpp"
 #include "sources/DepthScale.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/SyntheticSource.hpp"
@@ -361,9 +363,20 @@ int runClip(Options options, std::optional<GlSession>& gl)
     sinkOptions.overwrite = options.overwrite;
     sinkOptions.codec = options.codec;
     auto sink = openSink(sinkOptions);
+    // A camera to a virtual camera: never make the camera wait, drop what the filter cannot keep up with.
+    NewestFrameSource* newest = nullptr;
+    if (source->isLive() && dynamic_cast<V4l2OutputSink*>(sink.get())) {
+        auto feed = std::make_unique<NewestFrameSource>(std::move(source), [] { return cli::stopRequested(); });
+        newest = feed.get();
+        source = std::move(feed);
+    }
     if (!options.quiet)
         spdlog::info("{} -> {} on {}", source->describe(), options.output, gl->context.info().glRenderer);
-    return processClip(options, *source, demo, *sink, *gl);
+    const int status = processClip(options, *source, demo, *sink, *gl);
+    if (newest && !options.quiet)
+        spdlog::info("live: {} frames captured, {} dropped (the filter was slower than the camera)",
+                     newest->captured(), newest->dropped());
+    return status;
 }
 
 /// The command line, bound to `o`.

@@ -141,9 +141,10 @@ echo "v4l2-vm: booted at $(uptime) s"
 for m in virtio_pci 9pnet_virtio 9p; do modprobe $m || echo "v4l2-vm: modprobe $m failed"; done
 # One vivid instance with only a video capture node: /dev/video0.
 modprobe vivid n_devs=1 node_types=0x1 || echo "v4l2-vm: modprobe vivid failed"
-# Three loopback nodes, /dev/video1..3 (Z16, MJPG, Z16 for pairing), 4 buffers each.
-[ -e /lib/modules/v4l2loopback.ko ] && { insmod /lib/modules/v4l2loopback.ko devices=3 video_nr=1,2,3 \
-  max_buffers=4 || echo "v4l2-vm: insmod v4l2loopback failed"; }
+# Six loopback nodes, /dev/video1..6 (Z16, MJPG, Z16 for pairing; the virtual camera for the
+# command line, for defocus ! v4l2sink, and for v4l2sink alone), 4 buffers each.
+[ -e /lib/modules/v4l2loopback.ko ] && { insmod /lib/modules/v4l2loopback.ko devices=6 video_nr=1,2,3,4,5,6 \
+  max_buffers=4 $(arg defocus.loopback_options) || echo "v4l2-vm: insmod v4l2loopback failed"; }
 mount -t 9p -o trans=virtio,version=9p2000.L,ro,cache=loose,msize=512000 host0 /host ||
   echo "v4l2-vm: mounting the host root failed"
 mount -t devtmpfs devtmpfs /host/dev
@@ -187,6 +188,13 @@ EOS
   run /bin/sh /dev/shm/cli.sh "$cli" || rc=1
   echo "v4l2-vm: command line done at $(uptime) s"
 fi
+vcam=$(arg defocus.vcam)
+if [ -n "$vcam" ]; then
+  # The virtual camera: defocus (and, with defocus.gst=1, gst-launch-1.0) writes a loopback node
+  # while a reader captures it (scripts/v4l2-vm-vcam.sh).
+  run /bin/bash "$vcam" "$(arg defocus.build)" "$(arg defocus.cache)/vcam-input" "$(arg defocus.gst)" || rc=1
+  echo "v4l2-vm: virtual camera done at $(uptime) s"
+fi
 echo "V4L2-VM-RESULT $rc at $(uptime) s"
 poweroff -f
 EOF
@@ -199,14 +207,30 @@ say "prepared in $(elapsed "$start") s ($(basename "$kernel"), $(du -h "$cache/i
 cli=$(readlink -f "$(dirname "$probe")/../defocus")
 [ -x "$cli" ] || fail "no defocus binary at $cli (build the 'defocus' target)"
 
+# DEFOCUS_V4L2_VM_VCAM=1 also runs the virtual-camera test (scripts/v4l2-vm-vcam.sh: defocus -o
+# /dev/video4 read back as a webcam); with DEFOCUS_V4L2_VM_GST=1 it also tries GStreamer's
+# v4l2sink (docs/v4l2.md says how that ends). DEFOCUS_V4L2_VM_LOOPBACK="exclusive_caps=..." adds
+# options to v4l2loopback.
+vcam="" build=""
+if [ "${DEFOCUS_V4L2_VM_VCAM:-0}" = 1 ]; then
+  build=$(readlink -f "$(dirname "$probe")/..")
+  for f in "$build/defocus" "$build/tests/v4l2-vcam-check"; do [ -x "$f" ] || fail "DEFOCUS_V4L2_VM_VCAM=1 but there is no $f"; done
+  [ "$expectLoopback" = 1 ] || fail "DEFOCUS_V4L2_VM_VCAM=1 but v4l2loopback did not build"
+  vcam="$root/scripts/v4l2-vm-vcam.sh"
+  # Its input: 3 frames of the bundled clip at half size, made here (the VM sees this folder).
+  [ -s "$cache/vcam-input/depth/000002.png" ] ||
+    "$build/tests/v4l2-vcam-check" prepare "$root/data/tum_fr1_rpy" 3 "$cache/vcam-input" ||
+    fail "could not prepare the virtual camera's input in $cache/vcam-input"
+fi
+
 # ---- the VM: software emulation (TCG; this host's nested KVM does not run the stock kernel) ----
 command -v qemu-system-x86_64 >/dev/null || skip "no qemu-system-x86_64"
 vmstart=$(date +%s.%N)
 status=0
-timeout 400 qemu-system-x86_64 -nodefaults -no-user-config -machine pc -m 1024 -smp 1 \
+timeout "$([ -n "$vcam" ] && echo 1700 || echo 400)" qemu-system-x86_64 -nodefaults -no-user-config -machine pc -m 1024 -smp 1 \
   -display none -serial stdio -no-reboot \
   -kernel "$kernel" -initrd "$cache/initramfs.cpio" \
-  -append "console=ttyS0 quiet panic=-1 defocus.probe=$probe defocus.loopback=$expectLoopback defocus.cli=$cli" \
+  -append "console=ttyS0 quiet panic=-1 defocus.probe=$probe defocus.loopback=$expectLoopback defocus.cli=$cli defocus.vcam=$vcam defocus.build=$build defocus.cache=$cache defocus.gst=${DEFOCUS_V4L2_VM_GST:-0} defocus.loopback_options=${DEFOCUS_V4L2_VM_LOOPBACK:-}" \
   -virtfs local,path=/,mount_tag=host0,security_model=none,readonly=on,multidevs=remap \
   </dev/null >"$cache/vm.log" 2>&1 || status=$?
 tr -d '\r' <"$cache/vm.log" >"$cache/vm.txt"
