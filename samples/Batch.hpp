@@ -88,6 +88,33 @@ void writeReport(const std::filesystem::path& path, const nlohmann::json& report
 /// commit, OpenCV's version (it encodes the videos), the host and the compiler.
 nlohmann::json buildInfo();
 
+/// What one clip gave: its exit status (ExitStatus.hpp) and what its report says besides the
+/// fields runBatch() adds (frames in and out, settings, renderer, timings, the error).
+struct ClipOutcome {
+    int status = 0;
+    nlohmann::json report = nlohmann::json::object();
+};
+/// Runs clips on one worker; made on the worker's own thread (it owns a GL context there).
+using ClipRunner = std::function<ClipOutcome(const Clip&)>;
+
+struct BatchOptions {
+    std::filesystem::path reportDir; ///< empty: reports beside the outputs
+    bool redo = false;               ///< run clips that have a report again
+    std::size_t inFlight = 1;        ///< clips processed at once, one worker thread each
+    Shard shard;                     ///< for the reports
+};
+
+/// Runs `clips` (this process's shard) on `options.inFlight` workers, each made by
+/// `makeWorker(worker)` on its own thread; a worker that cannot be made (no GL) throws. Clips
+/// with a report are skipped unless `redo`. After each clip: status 0 (done) or 1 (bad input,
+/// which a retry would not mend) writes its report, last; any other status (stopped, GL lost)
+/// removes its partial output and writes none, so a rerun does it again. No new clip starts
+/// once `stopRequested()` or once a clip or worker gave 75. Returns the batch's status: the
+/// stop's (130, 143) when stopped, else 75 when GL failed, else 1 when a clip failed, else 0.
+int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
+             const std::function<ClipRunner(std::size_t worker)>& makeWorker,
+             const std::function<int()>& stopStatus);
+
 /// Removes what a clip that did not finish left at `output`: a file, or a folder output's
 /// numbered frames (and the folder, when it is left empty). Never throws; returns what it removed.
 std::size_t removePartialOutput(const std::filesystem::path& output);

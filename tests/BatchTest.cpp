@@ -1,7 +1,10 @@
 // defocus --batch without GL: the manifest (TSV and JSON lines, per-clip options, what it
 // refuses), the shard a process takes (--shard, Slurm array variables), report paths, the atomic
 // report and the removal of a clip's partial output.
+#include <atomic>
+#include <chrono>
 #include <fstream>
+#include <thread>
 #include <map>
 #include <set>
 #include <sstream>
@@ -225,6 +228,128 @@ TEST(PartialOutput, RemovesTheClipsFilesOnly)
     EXPECT_EQ(removePartialOutput(dir / "mixed"), 1u);
     EXPECT_TRUE(fs::exists(dir / "mixed" / "notes.txt"));
     EXPECT_EQ(removePartialOutput(dir / "nothing.mp4"), 0u);
+}
+
+/// A manifest of `n` clips writing into `dir`, and a fake worker that "renders" a clip by
+/// writing its output file, or gives the status `statusOf` says.
+struct FakeBatch {
+    fs::path dir;
+    std::vector<Clip> clips;
+    std::map<std::size_t, int> statusOf; // clip index -> status (default 0)
+    std::atomic<int> runs{0};
+    std::atomic<int> stop{0};
+    std::atomic<int> inFlight{0}, mostInFlight{0};
+
+    FakeBatch(const std::string& name, int n) : dir(test::scratchDir(name))
+    {
+        std::string text;
+        for (int i = 0; i < n; ++i)
+            text += fmt::format("in{}\t-\tout/clip{}.mp4\n", i, i);
+        std::istringstream in(text);
+        clips = parseManifest(in, "m.tsv", dir);
+    }
+    int run(std::size_t workers = 1, bool redo = false)
+    {
+        BatchOptions options;
+        options.inFlight = workers;
+        options.redo = redo;
+        return runBatch(
+            clips, options,
+            [this](std::size_t) -> ClipRunner {
+                return [this](const Clip& clip) {
+                    const int now = ++inFlight;
+                    for (int seen = mostInFlight; now > seen && !mostInFlight.compare_exchange_weak(seen, now);)
+                        ;
+                    ++runs;
+                    fs::create_directories(clip.output.parent_path());
+                    std::ofstream(clip.output) << "frames";
+                    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                    --inFlight;
+                    ClipOutcome outcome;
+                    const auto found = statusOf.find(clip.index);
+                    outcome.status = found == statusOf.end() ? 0 : found->second;
+                    if (outcome.status == 143)
+                        stop = 143; // as the signal handler would
+                    outcome.report["frames_out"] = 3;
+                    return outcome;
+                };
+            },
+            [this] { return stop.load(); });
+    }
+    bool reported(std::size_t clip) const { return hasReport(reportPath(clips[clip], {})); }
+};
+
+// Defect: a rerun after preemption doing finished clips again (or not doing unfinished ones), or
+// a report written for a clip whose output is not complete.
+TEST(RunBatch, StopLeavesUnfinishedClipsToTheRerunAndSkipsDoneOnes)
+{
+    FakeBatch batch("BatchRunStop", 4);
+    batch.statusOf[1] = 143; // SIGTERM while clip 1 is in hand
+    EXPECT_EQ(batch.run(), 143);
+    EXPECT_TRUE(batch.reported(0));
+    EXPECT_FALSE(batch.reported(1));
+    EXPECT_FALSE(fs::exists(batch.clips[1].output)) << "the stopped clip's partial output is removed";
+    EXPECT_FALSE(batch.reported(2)) << "no clip starts after the stop";
+    EXPECT_EQ(batch.runs, 2);
+    std::ifstream in(reportPath(batch.clips[0], {}));
+    const auto report = nlohmann::json::parse(in);
+    EXPECT_EQ(report["status"], "done");
+    EXPECT_EQ(report["exit_status"], 0);
+    EXPECT_EQ(report["frames_out"], 3);
+    EXPECT_EQ(report["clip"]["manifest_line"], 1);
+    EXPECT_EQ(report["build"]["version"], "0.1.0");
+
+    batch.statusOf.clear();
+    batch.stop = 0;
+    batch.runs = 0;
+    EXPECT_EQ(batch.run(), 0);
+    EXPECT_EQ(batch.runs, 3) << "the rerun does clips 1-3 only";
+    for (std::size_t i = 0; i < 4; ++i)
+        EXPECT_TRUE(batch.reported(i)) << i;
+    batch.runs = 0;
+    EXPECT_EQ(batch.run(1, true), 0);
+    EXPECT_EQ(batch.runs, 4) << "--redo does them all";
+}
+
+// Defect: a bad clip stopping the batch or retried forever (it gets a report saying it failed
+// and the batch goes on, exiting 1), or a GL failure taken for a bad clip (it must exit 75, retry,
+// with no report, and start no more clips).
+TEST(RunBatch, BadClipsAreReportedAndGlFailuresAreRetried)
+{
+    FakeBatch bad("BatchRunBad", 3);
+    bad.statusOf[0] = 1;
+    EXPECT_EQ(bad.run(), 1);
+    EXPECT_TRUE(bad.reported(0));
+    EXPECT_TRUE(bad.reported(2));
+    std::ifstream in(reportPath(bad.clips[0], {}));
+    EXPECT_EQ(nlohmann::json::parse(in)["status"], "failed");
+
+    FakeBatch gl("BatchRunGl", 3);
+    gl.statusOf[1] = 75;
+    EXPECT_EQ(gl.run(), 75);
+    EXPECT_TRUE(gl.reported(0));
+    EXPECT_FALSE(gl.reported(1));
+    EXPECT_FALSE(gl.reported(2));
+
+    FakeBatch noContext("BatchRunNoContext", 2);
+    BatchOptions options;
+    EXPECT_EQ(runBatch(
+                  noContext.clips, options,
+                  [](std::size_t) -> ClipRunner { throw std::runtime_error("no headless OpenGL 4.5 context"); },
+                  [] { return 0; }),
+              75);
+    EXPECT_FALSE(noContext.reported(0));
+}
+
+// Defect: --jobs 2 running one clip at a time, or two workers taking the same clip.
+TEST(RunBatch, TwoWorkersRunTwoClipsAtOnceEachOnce)
+{
+    FakeBatch batch("BatchRunTwo", 6);
+    EXPECT_EQ(batch.run(2), 0);
+    EXPECT_EQ(batch.runs, 6);
+    EXPECT_EQ(batch.mostInFlight, 2);
+    for (std::size_t i = 0; i < 6; ++i)
+        EXPECT_TRUE(batch.reported(i)) << i;
 }
 
 } // namespace
