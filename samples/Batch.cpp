@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <atomic>
@@ -382,6 +383,15 @@ std::string utcNow()
     return text;
 }
 
+/// A result line on stdout, whole even with several workers (a scheduler's log is read by scripts).
+void say(const std::string& line)
+{
+    static std::mutex lock;
+    const std::lock_guard guard(lock);
+    std::fputs(("defocus: " + line + "\n").c_str(), stdout);
+    std::fflush(stdout);
+}
+
 /// The scheduler's names for this run, so that a report says which task and attempt made it.
 nlohmann::json schedulerInfo()
 {
@@ -402,7 +412,7 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
     std::size_t skipped = 0;
     for (const Clip& clip : clips) {
         if (!options.redo && hasReport(reportPath(clip, options.reportDir))) {
-            spdlog::info("clip {} ({}): has a report, skipped", clip.index, clip.outputAsWritten);
+            say(fmt::format("clip {} ({}): has a report, skipped", clip.index, clip.outputAsWritten));
             ++skipped;
             continue;
         }
@@ -475,8 +485,8 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
                 status = 1;
             }
             if (status == 0)
-                spdlog::info("clip {} ({}): done in {:.1f} s, report {}", clip.index, clip.outputAsWritten, wall,
-                             path.string());
+                say(fmt::format("clip {} ({}): done in {:.1f} s, report {}", clip.index, clip.outputAsWritten, wall,
+                                path.string()));
             else
                 spdlog::error("clip {} ({}): failed: {}", clip.index, clip.outputAsWritten,
                               report.value("error", std::string("see the messages above")));
@@ -495,11 +505,9 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
             thread.join();
     }
     const std::size_t notStarted = todo.size() - std::min(todo.size(), done + failed + unfinished);
-    std::puts(fmt::format("defocus: batch shard {}: {} clips done, {} failed, {} skipped (report there), {} not "
-                          "finished, {} not started",
-                          shard, done, failed, skipped, unfinished, notStarted)
-                  .c_str());
-    std::fflush(stdout);
+    say(fmt::format("batch shard {}: {} clips done, {} failed, {} skipped (report there), {} not finished, {} not "
+                    "started",
+                    shard, done, failed, skipped, unfinished, notStarted));
     if (const int stop = stopStatus(); stop != 0)
         return stop;
     if (glFailed)
