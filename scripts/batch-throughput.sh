@@ -4,9 +4,10 @@
 #   per-core   one process per core, each a shard (scripts/batch-parallel.sh, GNU parallel)
 #   in-flight  one process, two clips in flight (--in-flight 2: two workers, a GL context each)
 #   serial     one process, one clip at a time
-# Prints one line per way and the load average before and after (other work on the machine
-# slows every way; compare the ways within one run only).
-#   scripts/batch-throughput.sh build/defocus [CLIPS=12] [FRAMES=4]
+# The ways take turns, ROUNDS times (default 3), and the median of each is printed with the load
+# average before and after: other work on the machine slows every way, so compare the ways within
+# one run only.
+#   scripts/batch-throughput.sh build/defocus [CLIPS=12] [FRAMES=4]       ROUNDS=5 ...
 set -eu
 defocus=$(realpath "${1:?usage: batch-throughput.sh DEFOCUS_BINARY [CLIPS] [FRAMES]}")
 clips=${2:-12}
@@ -19,22 +20,30 @@ for k in $(seq 0 $((clips - 1))); do
 done > "$tmp/clips.tsv"
 cd "$tmp"
 echo "batch-throughput: $clips clips x $frames frames, $(nproc) cores, $(date -u +%FT%TZ)," \
-  "commit $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  "commit $(git -C "$root" describe --always --dirty 2>/dev/null || echo unknown)"
 echo "batch-throughput: load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
-measure() { # NAME COMMAND...
+rounds=${ROUNDS:-3}
+measure() { # NAME COMMAND... ; appends the wall time to NAME.times
   local name=$1; shift
   rm -rf out
-  local start end
+  local start end done
   start=$(date +%s.%N)
   "$@" > "$name.log" 2>&1 || { echo "batch-throughput: $name failed:"; tail -n 20 "$name.log"; exit 1; }
   end=$(date +%s.%N)
-  local done
   done=$(ls out/*.report.json | wc -l)
   [ "$done" -eq "$clips" ] || { echo "batch-throughput: $name did $done of $clips clips"; exit 1; }
-  awk -v n="$name" -v c="$clips" -v s="$start" -v e="$end" \
-    'BEGIN { printf "batch-throughput: %-9s %6.1f s  %6.1f clips/min\n", n, e - s, c * 60 / (e - s) }'
+  awk -v s="$start" -v e="$end" 'BEGIN { printf "%.3f\n", e - s }' >> "$name.times"
 }
-measure per-core env DEFOCUS="$defocus" JOBS="$(nproc)" "$root/scripts/batch-parallel.sh" clips.tsv -q
-measure in-flight "$defocus" --batch clips.tsv --in-flight 2 -q
-measure serial "$defocus" --batch clips.tsv -q
+for _ in $(seq "$rounds"); do
+  measure per-core env DEFOCUS="$defocus" JOBS="$(nproc)" "$root/scripts/batch-parallel.sh" clips.tsv -q
+  measure in-flight "$defocus" --batch clips.tsv --in-flight 2 -q
+  measure serial "$defocus" --batch clips.tsv -q
+done
+for name in per-core in-flight serial; do
+  sort -n "$name.times" | awk -v n="$name" -v c="$clips" '{ t[NR] = $1 } END {
+    m = t[int((NR + 1) / 2)]
+    printf "batch-throughput: %-9s median %6.1f s  %6.1f clips/min  (runs:", n, m, c * 60 / m
+    for (i = 1; i <= NR; i++) printf " %.1f", t[i]
+    printf " s)\n" }'
+done
 echo "batch-throughput: load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
