@@ -11,7 +11,7 @@
 //   JSON lines: {"input": "...", "depth": "...", "output": "...", "focus": 1.2, "near-field": false}
 //               every key other than input/depth/output is an option: a string or number is its
 //               value, true gives the flag, false its --no- form (or nothing where there is none)
-// Per-clip options are the lens, quality and output options of kClipOptions; the others
+// Per-clip options are the lens, quality and output options of clipOptions(); the others
 // (--batch, --shard, --report-dir, --egl-device, ...) are the whole run's and are refused here.
 #pragma once
 
