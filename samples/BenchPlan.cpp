@@ -19,6 +19,8 @@
 #include "sources/FrameSource.hpp"
 #include "sources/SyntheticSource.hpp"
 
+#include "samples/ExitStatus.hpp"
+
 namespace defocus {
 
 namespace {
@@ -63,7 +65,7 @@ int runPlanComparison(const PlanOptions& options)
     if (!std::filesystem::is_directory(options.data)) {
         std::fprintf(stderr, "defocus-bench plan: data '%s' not found (run from the repository root or pass --data)\n",
                      options.data.c_str());
-        return 2;
+        return kExitBadInput;
     }
     auto context = gl::EglContext::create();
     std::vector<Clip> clips;

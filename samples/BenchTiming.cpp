@@ -19,6 +19,8 @@
 #include "samples/BenchMachine.hpp"
 #include "sources/FrameSource.hpp"
 
+#include "samples/ExitStatus.hpp"
+
 namespace defocus {
 
 int runTimingComparison(const TimingOptions& options)
@@ -26,12 +28,12 @@ int runTimingComparison(const TimingOptions& options)
     if (!std::filesystem::exists(options.data)) {
         std::fprintf(stderr, "defocus-bench timing: data '%s' not found (run from the repository root or pass --data)\n",
                      options.data.c_str());
-        return 2;
+        return kExitBadInput;
     }
     auto context = gl::EglContext::create();
     if (!context.info().timerQueries) {
         std::fprintf(stderr, "defocus-bench timing: %s has no GPU timer queries\n", context.info().glRenderer.c_str());
-        return 2;
+        return kExitUnavailable;
     }
     auto source = openSource({options.data, std::nullopt, std::nullopt});
     std::vector<Frame> frames;
@@ -102,7 +104,7 @@ int runTimingComparison(const TimingOptions& options)
     } catch (const nlohmann::json::exception& error) {
         std::fprintf(stderr, "defocus-bench timing: cannot read baseline '%s': %s\n", options.baseline.c_str(),
                      error.what());
-        return 2;
+        return kExitBadInput;
     }
     if (const auto timed = baseline.value("preset", std::string("(not recorded)")); timed != options.preset)
         std::printf("note: the baseline timed --quality %s, this run --quality %s\n", timed.c_str(),

@@ -2,12 +2,14 @@
 //   defocus data/tum_fr1_rpy -o out/tum.mp4 --focus 1.2 --f-number 1.4
 //   defocus photo.png --depth depth.png --depth-scale 1000 -o out.png --view coc
 //   defocus --info
+// The flow: parse the command line (declareOptions, finishOptions) -> runClip(options, gl), which
+// opens the input and output and hands them to processClip; the GL context and pipeline (GlSession)
+// are opened once and can serve several clips. Results go to standard output, diagnostics to
+// standard error; the exit statuses are ExitStatus.hpp's.
 #include <algorithm>
-#include <atomic>
 #include <csignal>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <string>
 
@@ -26,24 +28,19 @@
 #include "filter/Views.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
+#include "samples/CliOptions.hpp"
+#include "samples/ExitStatus.hpp"
+#include "samples/FocusSchedule.hpp"
 #include "samples/Progress.hpp"
 #include "sinks/FrameSink.hpp"
+#include "sinks/ImageSinks.hpp"
+#include "sources/DepthScale.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/SyntheticSource.hpp"
 
 namespace {
 
 using namespace defocus;
-
-std::atomic<bool> gStop{false};
-
-extern "C" void onSignal(int)
-{
-    gStop = true;
-}
-
-/// Exit codes: 0 done, 1 runtime failure (input, output, GL), 2 bad command line, 130 stopped.
-enum Exit { kOk = 0, kFailure = 1, kUsage = 2, kInterrupted = 130 };
 
 struct Options {
     std::string input;
@@ -62,7 +59,12 @@ struct Options {
     std::string view = "composite";
     std::string contactSheet;
     std::size_t contactFrame = 0;
-    std::optional<std::size_t> frames;
+    std::optional<std::size_t> frames; ///< frames out at most
+    std::size_t start = 0;             ///< input frames skipped first
+    std::size_t every = 1;             ///< then every Nth input frame
+    std::string focusPoint;            ///< --focus-point X,Y; "" = the centre
+    AutofocusSettings autofocus;       ///< --focus track: --tau
+    double depthScaleUsed = 0.0;       ///< the scale the input is read at (for the plausibility check)
     std::optional<double> fps;
     std::string timings;
     bool explain = false;
@@ -71,6 +73,10 @@ struct Options {
     std::string demoScene = "spheres";
     bool quiet = false;
     bool verbose = false;
+    bool overwrite = false;   ///< -y: replace outputs that exist
+    std::string codec;        ///< --codec, "" = the container's default
+    std::string imageFormat = "png"; ///< --image-format of a folder output
+    bool alwaysOn = false;
 };
 
 int printInfo()
@@ -81,7 +87,7 @@ int printInfo()
                "GL version:   {}\nGPU timers:   {}\n",
                info.platform, info.eglVendor, info.eglVersion, info.glVendor, info.glRenderer, info.glVersion,
                info.timerQueries ? "yes" : "no");
-    return kOk;
+    return kExitDone;
 }
 
 std::string summarise(std::size_t in, std::size_t out, const std::map<std::string, double>& passMs,
@@ -154,10 +160,7 @@ public:
                                  {"height", size.height},
                                  {"summary", summary},
                                  {"frames", frames_}};
-        std::ofstream out(file);
-        out << doc.dump(2) << "\n";
-        if (!out)
-            throw SinkError(fmt::format("cannot write timings '{}'", file));
+        writeFileAtomically(file, doc.dump(2) + "\n");
     }
 
 private:
@@ -175,69 +178,85 @@ std::unique_ptr<SyntheticSource> openDemo(const Options& options)
     return std::make_unique<SyntheticSource>(syntheticScene(options.demoScene), settings);
 }
 
-int run(const Options& options)
-{
-    // --demo renders its frames with GL, so its context comes first (the filter shares it).
-    std::optional<gl::EglContext> demoContext;
-    std::unique_ptr<FrameSource> source;
-    SyntheticSource* demo = nullptr;
-    if (options.demo) {
-        demoContext.emplace(gl::EglContext::create());
-        auto synthetic = openDemo(options);
-        demo = synthetic.get();
-        source = std::move(synthetic);
-    } else {
-        SourceOptions sourceOptions{options.input, std::nullopt, options.depthScale};
-        if (!options.depth.empty())
-            sourceOptions.depth = options.depth;
-        source = openSource(sourceOptions);
-    }
+/// What several clips can share: the GL context and the pipeline with its compiled shaders.
+struct GlSession {
+    explicit GlSession(gl::EglContext glContext) : context(std::move(glContext)) {}
+    gl::EglContext context; ///< first: the pipeline's GL objects live in it
+    Pipeline pipeline;
+};
 
+/// The frames of one clip from `source` through the pipeline into `sink`; returns the exit status.
+/// Stops early at SIGINT/SIGTERM (the sink is finalised all the same) or at an error (the frames
+/// before it are kept).
+int processClip(const Options& options, FrameSource& source, SyntheticSource* demo, FrameSink& sink, GlSession& gl)
+{
     View view = View::Composite;
     parseView(options.view, view); // validated by CLI11's check
+    Pipeline& pipeline = gl.pipeline;
+    const Encoding encoding = sink.encoding() == SinkEncoding::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
 
-    SinkOptions sinkOptions{options.output, options.fps.value_or(source->frameRate() > 0 ? source->frameRate() : 30.0),
-                            false};
-    auto sink = openSink(sinkOptions);
-
-    auto context = demoContext ? std::move(*demoContext) : gl::EglContext::create();
-    Pipeline pipeline;
-    if (!options.quiet)
-        spdlog::info("{} -> {} on {}", source->describe(), options.output, context.info().glRenderer);
-    const Encoding encoding = sink->encoding() == SinkEncoding::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
-
-    std::optional<std::size_t> total = source->frameCount();
+    std::optional<std::size_t> total = source.frameCount();
     if (options.frames)
         total = total ? std::min(*total, *options.frames) : *options.frames;
     Progress progress(total, !options.quiet);
 
     LensSettings lens = options.lens;
+    std::optional<cv::Point2d> point;
+    if (!options.focusPoint.empty())
+        point = parsePoint(options.focusPoint); // checked by finishOptions
+    FocusControl focus(options.focus, point, options.autofocus);
+    if (!options.quiet && !demo)
+        spdlog::info("focus: {}", focus.describe());
+    const double fps = source.frameRate() > 0.0 ? source.frameRate() : 30.0;
+    std::optional<double> firstTimestamp;
+    double previousTimestamp = 0.0;
+    std::size_t read = 0;         // input frames read, selected or not
+    bool depthChecked = false;
     TimingLog timingLog;
     cv::Size frameSize;
     std::map<std::string, double> passMs;
     double totalMs = 0, uploadMs = 0, readbackMs = 0;
     std::size_t framesIn = 0, timed = 0;
     std::size_t current = 0; // index of the frame being read or processed, for messages
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
 
-    int exitCode = kOk;
+    int status = kExitDone;
     try {
-        while (!gStop && (!options.frames || framesIn < *options.frames)) {
+        while (!cli::stopRequested() && (!options.frames || framesIn < *options.frames)) {
             current = framesIn;
-            std::optional<Frame> frame = source->next();
+            std::optional<Frame> frame = source.next();
             if (!frame)
                 break;
+            const std::size_t position = read++;
+            if (!firstTimestamp)
+                firstTimestamp = frame->timestamp;
+            if (position < options.start || (position - options.start) % options.every != 0)
+                continue; // --start, --every
             ++framesIn;
+            if (!depthChecked && !demo && options.depthScaleUsed > 0.0) {
+                const DepthScaleCheck check = checkDepthScale(frame->depth, options.depthScaleUsed, frame->name);
+                depthChecked = check.validPixels > 0;
+                if (!check.warning.empty())
+                    spdlog::warn("{}", check.warning);
+            }
+            // Seconds since the clip's first frame, for focus keys: its timestamps when it has
+            // them, else the frame's index at the frame rate.
+            const bool stamped = *firstTimestamp > 0.0 && frame->timestamp > 0.0;
+            const double timeS = stamped ? frame->timestamp - *firstTimestamp : static_cast<double>(frame->index) / fps;
+            const double dtS = frameInterval(previousTimestamp, frame->timestamp, static_cast<double>(options.every) / fps);
+            previousTimestamp = frame->timestamp;
             if (demo && options.focus == "auto") {
                 lens.focusM = demo->lensAt(frame->index).focusM; // the scene's focus pull
-            } else if (framesIn == 1 && options.focus == "auto") {
-                lens.focusM = centreDepth(frame->depth, 0.1, 2.0f);
-                if (!options.quiet)
-                    spdlog::info("focus: auto -> {:.2f} m (median depth of the centre of {})", lens.focusM, frame->name);
+            } else if (!focus.isFixed()) {
+                lens.focusM = focus.focusFor(*frame, timeS, dtS);
+                if (framesIn == 1 && options.focus == "auto" && !options.quiet)
+                    spdlog::info("focus: auto -> {:.2f} m (median depth around {} of {})", lens.focusM,
+                                 point ? options.focusPoint : std::string("the centre"), frame->name);
                 if (const auto issues = validate(lens); !issues.empty())
-                    throw std::runtime_error(fmt::format("automatic focus: {}", issues.front().message));
+                    throw std::runtime_error(fmt::format("focus {:.3f} m at frame {}: {}", lens.focusM, frame->index,
+                                                         issues.front().message));
             }
+            if (options.explain)
+                std::printf("frame %zu: focus %.4f m\n", frame->index, lens.focusM);
             const cv::Mat image = pipeline.run(*frame, lens, options.quality, view, encoding);
             if (!options.contactSheet.empty() && frame->index == options.contactFrame) {
                 std::vector<std::pair<std::string, cv::Mat>> tiles;
@@ -246,11 +265,10 @@ int run(const Options& options)
                     tiles.emplace_back(fmt::format("{} {}", number++, viewName(v)), pipeline.read(v, Encoding::Srgb8));
                 tiles.emplace_back("plan: blur tiles outlined, copied dimmed, near field blue",
                                    drawTileMap(tiles.front().second, pipeline.plan(), pipeline.analysis()));
-                if (!cv::imwrite(options.contactSheet, contactSheet(tiles)))
-                    throw SinkError(fmt::format("cannot write contact sheet '{}'", options.contactSheet));
+                writeImageAtomically(options.contactSheet, contactSheet(tiles));
                 pipeline.run(*frame, lens, options.quality, view, encoding); // keep timings of a plain frame
             }
-            sink->write(image);
+            sink.writeFrame(image, *frame);
             frameSize = image.size();
             if (options.explain)
                 std::printf("frame %zu: %s\n", frame->index, pipeline.plan().explain(pipeline.analysis()).c_str());
@@ -268,39 +286,84 @@ int run(const Options& options)
     } catch (const std::exception& error) {
         progress.finish();
         spdlog::error("frame {}: {}", current, error.what());
-        exitCode = kFailure;
+        status = cli::statusFor(error);
     }
-    sink->finish();
+    try {
+        sink.finish();
+    } catch (const std::exception& error) {
+        spdlog::error("{}", error.what());
+        status = cli::statusFor(error);
+    }
     progress.finish();
     const auto lastGpu = pipeline.drainGpuTimes();
     if (framesIn > 0)
         timingLog.gpu(lastGpu, framesIn - 1);
     for (const auto& pass : lastGpu)
         passMs[pass.name] += pass.ms;
-    if (!options.timings.empty())
-        timingLog.write(options.timings, context.info().glRenderer, frameSize);
-    if (gStop) {
-        spdlog::warn("stopped by signal after {} frames; {} is finalised", framesIn, options.output);
-        exitCode = kInterrupted;
+    if (!options.timings.empty() && framesIn > 0)
+        timingLog.write(options.timings, gl.context.info().glRenderer, frameSize);
+    if (cli::stopRequested()) {
+        spdlog::warn("stopped by {} after {} frames; {} is finalised", cli::stopSignal() == SIGINT ? "Ctrl-C" : "SIGTERM",
+                     framesIn, options.output);
+        status = cli::stopStatus();
     }
-    if (exitCode == kOk && framesIn == 0) {
+    if (status == kExitDone && framesIn == 0) {
         spdlog::error("{} gave no frames", options.input);
-        return kFailure;
+        return kExitBadInput;
     }
-    std::puts(summarise(framesIn, sink->framesWritten(), passMs, totalMs, uploadMs, readbackMs, timed).c_str());
+    std::fflush(stdout);
+    std::puts(summarise(framesIn, sink.framesWritten(), passMs, totalMs, uploadMs, readbackMs, timed).c_str());
     if (!options.quiet)
-        spdlog::info("wrote {}", sink->describe());
-    return exitCode;
+        spdlog::info("wrote {}", sink.describe());
+    return status;
 }
 
-} // namespace
-
-int main(int argc, char** argv)
+/// One clip, from INPUT (or --demo) to -o OUTPUT: opens the input, the GL session when `gl` holds
+/// none yet (so a bad input is reported before GL is needed), the output, and runs processClip.
+/// Throws for an input, output or GL that cannot be opened (cli::statusFor gives the status).
+int runClip(Options options, std::optional<GlSession>& gl)
 {
-    Options o;
-    CLI::App app{"defocus: depth of field with hexagonal bokeh for RGB-D images and clips (McIntosh et al. 2012).\n"
-                 "INPUT is a TUM RGB-D folder (rgb.txt + depth.txt), a folder of colour images (with --depth "
-                 "FOLDER), or one colour image (with --depth FILE)."};
+    // Outputs besides the main one are checked before any frame is processed.
+    if (!options.contactSheet.empty())
+        refuseExisting(options.contactSheet, options.overwrite);
+    if (!options.timings.empty())
+        refuseExisting(options.timings, options.overwrite);
+
+    std::unique_ptr<FrameSource> source;
+    SyntheticSource* demo = nullptr;
+    if (options.demo) {
+        // --demo renders its frames with GL, so the context comes first (the filter shares it).
+        if (!gl)
+            gl.emplace(gl::EglContext::create());
+        auto synthetic = openDemo(options);
+        demo = synthetic.get();
+        source = std::move(synthetic);
+    } else {
+        SourceOptions sourceOptions{options.input, std::nullopt, options.depthScale};
+        if (!options.depth.empty())
+            sourceOptions.depth = options.depth;
+        source = openSource(sourceOptions);
+        options.depthScaleUsed = options.depthScale.value_or(defaultDepthScale(sourceOptions));
+    }
+
+    if (!gl)
+        gl.emplace(gl::EglContext::create());
+
+    SinkOptions sinkOptions;
+    sinkOptions.output = options.output;
+    sinkOptions.fps = options.fps.value_or(source->frameRate() > 0 ? source->frameRate() : 30.0);
+    sinkOptions.linearSequence = options.imageFormat == "exr";
+    sinkOptions.overwrite = options.overwrite;
+    sinkOptions.codec = options.codec;
+    auto sink = openSink(sinkOptions);
+    if (!options.quiet)
+        spdlog::info("{} -> {} on {}", source->describe(), options.output, gl->context.info().glRenderer);
+    return processClip(options, *source, demo, *sink, *gl);
+}
+
+/// The command line, bound to `o`.
+void declareOptions(CLI::App& app, Options& o)
+{
     app.set_version_flag("--version", "defocus 0.1.0");
     app.add_option("input", o.input, "Colour input: TUM folder, image folder or image file");
     app.add_option("-o,--output", o.output,
@@ -311,8 +374,9 @@ int main(int argc, char** argv)
                    "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
         ->check(CLI::PositiveNumber);
     app.add_option("--focus", o.focus,
-                   "Distance in focus, metres; 'inf' for infinity; 'auto' = median depth of the centre of the "
-                   "first frame")
+                   "Distance in focus, metres; 'inf' for infinity; 'auto' = median depth of the centre (or "
+                   "--focus-point) of the first frame; 'track' = follow it frame by frame (the preview's "
+                   "autofocus, --tau); keys such as 0s:1.2,2s:3.5 = a focus pull, eased in dioptres")
         ->capture_default_str();
     app.add_option("--f-number", o.lens.fNumber, "Aperture as an f-number N (smaller = more blur), 0.7..64")
         ->capture_default_str();
@@ -360,11 +424,20 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--contact-sheet", o.contactSheet, "Also write every view of one frame, labelled, to this PNG");
     app.add_option("--contact-frame", o.contactFrame, "Frame index for --contact-sheet")->capture_default_str();
-    app.add_option("--frames", o.frames, "Stop after this many frames")->check(CLI::PositiveNumber);
+    app.add_option("--frames", o.frames, "Stop after this many frames out")->check(CLI::PositiveNumber);
+    app.add_option("--start", o.start, "Skip this many input frames first")->capture_default_str();
+    app.add_option("--every", o.every, "Then take every Nth input frame (2 = every other)")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--focus-point", o.focusPoint,
+                   "X,Y: measure the focus at this pixel (the median of the valid depths in a window around it) "
+                   "instead of the centre; with --focus auto or track");
+    app.add_option("--tau", o.autofocus.timeConstantS, "--focus track: time constant, seconds (critically damped), >= 0")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     app.add_option("--fps", o.fps, "Frame rate of a video output, Hz [default: the input's]")->check(CLI::PositiveNumber);
     app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
     app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
-    bool alwaysOn = false;
     app.add_option("--highlight-gain", o.quality.highlightGain,
                    "8-bit input: scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
         ->capture_default_str();
@@ -374,7 +447,7 @@ int main(int argc, char** argv)
                  "Rhombi: lights brighter than white scatter as hexagons with exact edges (bokeh sprites) "
                  "[default: on]")
         ->capture_default_str();
-    app.add_flag("--always-on", alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
+    app.add_flag("--always-on", o.alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
     app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
     app.add_flag("--demo", o.demo,
                  "No INPUT: render a synthetic clip (60 frames, a focus pull; --frames sets its length) and blur "
@@ -385,57 +458,95 @@ int main(int argc, char** argv)
     app.add_flag("-q,--quiet", o.quiet, "Only the summary line and errors");
     app.add_flag("-v,--verbose", o.verbose, "Debug logging");
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+    app.add_flag("-y,--overwrite", o.overwrite, "Replace outputs that exist (without it, an existing output is refused)");
+    app.add_option("--codec", o.codec,
+                   "Video codec: h264 (default for .mp4), mp4v, ffv1 (lossless, default for .mkv), vp9 (default "
+                   "for .webm), mjpg (default for .avi)")
+        ->check(CLI::IsMember({"h264", "mp4v", "ffv1", "vp9", "mjpg"}));
+    app.add_option("--image-format", o.imageFormat,
+                   "Frames of a folder output: png (8-bit sRGB) or exr (linear float, HDR kept)")
+        ->check(CLI::IsMember({"png", "exr"}))
+        ->capture_default_str();
+}
+
+/// After parsing: presets under the explicit options, names to enums, ranges. nullopt: go on;
+/// otherwise the exit status (kExitUsage), with the reason logged.
+std::optional<int> finishOptions(const CLI::App& app, Options& o)
+{
+    if (o.demo && !o.input.empty()) {
+        spdlog::error("--demo renders its own input; drop INPUT '{}'", o.input);
+        return kExitUsage;
     }
-    spdlog::set_pattern("%^defocus: %l:%$ %v");
-    spdlog::set_level(o.verbose ? spdlog::level::debug : o.quiet ? spdlog::level::warn : spdlog::level::info);
+    if ((o.input.empty() && !o.demo) || o.output.empty()) {
+        spdlog::error("INPUT and -o OUTPUT are required (see --help)");
+        return kExitUsage;
+    }
+    const QualitySettings fromPreset = presetSettings(o.qualityPreset);
+    if (app.count("--samples") == 0)
+        o.quality.samples = fromPreset.samples;
+    if (app.count("--precision") == 0)
+        o.precision = fromPreset.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
+    if (app.count("--hexagon") == 0)
+        o.kernel = std::string(kernelName(fromPreset.kernel));
+    if (app.count("--near-field") == 0)
+        o.quality.nearField = fromPreset.nearField;
+    if (app.count("--resolution") == 0)
+        o.resolution = std::string(resolutionName(fromPreset.resolution));
+    o.quality.adaptive = !o.alwaysOn;
+    o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
+    parseFieldOfView(o.fov, o.lens.fieldOfView); // checked by CLI11
+    o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
+    parseKernel(o.kernel, o.quality.kernel);
+    parseResolution(o.resolution, o.quality.resolution);
+    try {
+        std::optional<cv::Point2d> point;
+        if (!o.focusPoint.empty())
+            point = parsePoint(o.focusPoint);
+        FocusControl check(o.focus, point, o.autofocus);
+    } catch (const std::invalid_argument& error) {
+        spdlog::error("{}", error.what());
+        return kExitUsage;
+    }
+    bool autoFocus = true; // auto, track and keys are checked frame by frame
+    if (o.focus != "auto" && o.focus != "track" && !FocusSchedule::isKeyed(o.focus) &&
+        !parseFocus(o.focus, o.lens, autoFocus)) {
+        spdlog::error("--focus '{}' is not metres, 'inf', 'auto', 'track' or keys", o.focus);
+        return kExitUsage;
+    }
+    const auto issues = validateCommandLine(o.lens, o.quality, autoFocus);
+    for (const auto& issue : issues)
+        spdlog::error("{}", issue.message);
+    if (!issues.empty())
+        return kExitUsage;
+    return std::nullopt;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    Options o;
+    CLI::App app{"defocus: depth of field with hexagonal bokeh for RGB-D images and clips (McIntosh et al. 2012).\n"
+                 "INPUT is a TUM RGB-D folder (rgb.txt + depth.txt), a folder of colour images (with --depth "
+                 "FOLDER), one colour image (with --depth FILE), a video file (with --depth FILE, FOLDER or "
+                 "depth.txt) or a V4L2 camera /dev/videoN (with --depth FILE or a Z16 camera); --demo needs none.\n"
+                 "Exit status: 0 done, 1 bad input or output, 2 command line, 75 no GL or busy device (retry), "
+                 "130 Ctrl-C, 143 SIGTERM."};
+    declareOptions(app, o);
+    if (const auto status = cli::parse(app, argc, argv))
+        return *status;
+    cli::logToStderr("defocus", o.quiet, o.verbose);
 
     try {
         if (o.info)
             return printInfo();
-        if (o.demo && !o.input.empty()) {
-            spdlog::error("--demo renders its own input; drop INPUT '{}'", o.input);
-            return kUsage;
-        }
-        if ((o.input.empty() && !o.demo) || o.output.empty()) {
-            spdlog::error("INPUT and -o OUTPUT are required (see --help)");
-            return kUsage;
-        }
-        {
-            const QualitySettings fromPreset = presetSettings(o.qualityPreset);
-            if (app.count("--samples") == 0)
-                o.quality.samples = fromPreset.samples;
-            if (app.count("--precision") == 0)
-                o.precision = fromPreset.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
-            if (app.count("--hexagon") == 0)
-                o.kernel = std::string(kernelName(fromPreset.kernel));
-            if (app.count("--near-field") == 0)
-                o.quality.nearField = fromPreset.nearField;
-            if (app.count("--resolution") == 0)
-                o.resolution = std::string(resolutionName(fromPreset.resolution));
-        }
-        o.quality.adaptive = !alwaysOn;
-        o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
-        parseFieldOfView(o.fov, o.lens.fieldOfView); // checked by CLI11
-        o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
-        parseKernel(o.kernel, o.quality.kernel);
-        parseResolution(o.resolution, o.quality.resolution);
-        bool autoFocus = false;
-        if (!parseFocus(o.focus, o.lens, autoFocus)) {
-            spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);
-            return kUsage;
-        }
-        const auto issues = validateCommandLine(o.lens, o.quality, autoFocus);
-        for (const auto& issue : issues)
-            spdlog::error("{}", issue.message);
-        if (!issues.empty())
-            return kUsage;
-        return run(o);
+        if (const auto status = finishOptions(app, o))
+            return *status;
+        cli::catchStopSignals();
+        std::optional<GlSession> gl;
+        return runClip(o, gl);
     } catch (const std::exception& error) {
         spdlog::error("{}", error.what());
-        return kFailure;
+        return cli::statusFor(error);
     }
 }

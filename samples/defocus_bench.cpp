@@ -33,6 +33,8 @@
 #include "samples/BenchMachine.hpp"
 #include "samples/BenchPlan.hpp"
 #include "samples/BenchTiming.hpp"
+#include "samples/CliOptions.hpp"
+#include "samples/ExitStatus.hpp"
 
 #include <unistd.h>
 
@@ -43,7 +45,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 /// Exit codes: 0 done, 1 runtime failure (data, GL, output), 2 bad command line.
-enum Exit { kOk = 0, kFailure = 1, kUsage = 2 };
 
 struct Options {
     std::string data = "data/tum_fr1_rpy";
@@ -384,7 +385,7 @@ int run(const Options& options, const std::string& commandLine)
         for (const auto& issue : issues)
             fmt::print(stderr, "defocus-bench: error: {}\n", issue.message);
         if (!issues.empty())
-            return kUsage;
+            return kExitUsage;
     }
 
     const std::vector<Frame> clip = loadClip(options.data);
@@ -492,90 +493,87 @@ int run(const Options& options, const std::string& commandLine)
             throw std::runtime_error(fmt::format("cannot write '{}'", options.json));
         fmt::print("\nwrote {}\n", options.json);
     }
-    return kOk;
+    return kExitDone;
 }
 
 } // namespace
 
 namespace {
 
-/// `defocus-bench timing ...`: the per-pass timing baseline and comparator (samples/BenchTiming.hpp).
-int timingMain(int argc, char** argv)
+/// `defocus-bench timing`: the per-pass timing baseline and comparator (samples/BenchTiming.hpp).
+CLI::App* declareTiming(CLI::App& app, defocus::TimingOptions& o)
 {
-    defocus::TimingOptions o;
-    CLI::App app{"defocus-bench timing: each pass's GPU time over a calibration pass measured in the same run, "
-                 "written as a baseline or compared with one"};
-    app.add_option("--data", o.data, "TUM RGB-D folder to take frames from")->capture_default_str();
-    app.add_option("--baseline", o.baseline, "Compare with this baseline JSON; exit 1 on a regression");
-    app.add_option("--write-baseline", o.writeBaseline, "Write the measured ratios to this JSON file");
-    app.add_option("--quality", o.preset, "Preset whose passes are timed: fast, balanced or high")
+    CLI::App* sub = app.add_subcommand("timing", "Each pass's GPU time over a calibration pass measured in the same run, "
+                                                 "written as a baseline or compared with one (exit 1 on a regression)");
+    sub->add_option("--data", o.data, "TUM RGB-D folder to take frames from")->capture_default_str();
+    sub->add_option("--baseline", o.baseline, "Compare with this baseline JSON; exit 1 on a regression");
+    sub->add_option("--write-baseline", o.writeBaseline, "Write the measured ratios to this JSON file");
+    sub->add_option("--quality", o.preset, "Preset whose passes are timed: fast, balanced or high")
         ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
-    app.add_option("--runs", o.runs, "Measured frames")->capture_default_str()->check(CLI::Range(3, 10000));
-    app.add_option("--max-ratio", o.maxRatio, "Largest allowed growth of a pass's ratio over the baseline")
+    sub->add_option("--runs", o.runs, "Measured frames")->capture_default_str()->check(CLI::Range(3, 10000));
+    sub->add_option("--max-ratio", o.maxRatio, "Largest allowed growth of a pass's ratio over the baseline")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    CLI11_PARSE(app, argc, argv);
-    try {
-        return defocus::runTimingComparison(o);
-    } catch (const std::exception& error) {
-        std::fprintf(stderr, "defocus-bench timing: %s\n", error.what());
-        return 2;
-    }
+    return sub;
 }
 
-/// `defocus-bench plan ...`: the plan against every pass on every pixel (samples/BenchPlan.hpp).
-int planMain(int argc, char** argv)
+/// `defocus-bench plan`: the plan against every pass on every pixel (samples/BenchPlan.hpp).
+CLI::App* declarePlan(CLI::App& app, defocus::PlanOptions& o)
 {
-    defocus::PlanOptions o;
-    CLI::App app{"defocus-bench plan: ms per frame with the per-frame plan and with every pass on every pixel, "
-                 "and how far apart their outputs are, on the TUM clip (f/2, f/22) and the synthetic clips"};
-    app.add_option("--data", o.data, "TUM RGB-D folder")->capture_default_str();
-    app.add_option("--quality", o.preset, "Preset: fast, balanced or high")
+    CLI::App* sub = app.add_subcommand("plan", "ms per frame with the per-frame plan and with every pass on every "
+                                               "pixel, and how far apart their outputs are, on the TUM clip (f/2, "
+                                               "f/22) and the synthetic clips");
+    sub->add_option("--data", o.data, "TUM RGB-D folder")->capture_default_str();
+    sub->add_option("--quality", o.preset, "Preset: fast, balanced or high")
         ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
-    app.add_option("--passes", o.passes, "Timed passes over each clip per mode")
+    sub->add_option("--passes", o.passes, "Timed passes over each clip per mode")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));
-    app.add_option("--synthetic-frames", o.syntheticFrames, "Frames of each synthetic clip")
+    sub->add_option("--synthetic-frames", o.syntheticFrames, "Frames of each synthetic clip")
         ->capture_default_str()
         ->check(CLI::Range(1, 10000));
-    CLI11_PARSE(app, argc, argv);
-    try {
-        return defocus::runPlanComparison(o);
-    } catch (const std::exception& error) {
-        std::fprintf(stderr, "defocus-bench plan: %s\n", error.what());
-        return 2;
-    }
+    return sub;
 }
 
-/// `defocus-bench accuracy ...` runs the accuracy sweep, built as its own program beside this one.
-int accuracyMain(int argc, char** argv, const char* self)
+/// `defocus-bench accuracy ...` runs the accuracy sweep, built as its own program beside this one,
+/// with the arguments after the subcommand (its --help included).
+int runAccuracy(const std::vector<std::string>& rest, const char* self)
 {
     const std::string program = (std::filesystem::path(self).parent_path() / "defocus-bench-accuracy").string();
-    std::vector<char*> args{const_cast<char*>(program.c_str())};
-    for (int i = 1; i < argc; ++i)
-        args.push_back(argv[i]);
+    std::vector<std::string> all{program};
+    all.insert(all.end(), rest.begin(), rest.end());
+    std::vector<char*> args;
+    for (auto& arg : all)
+        args.push_back(arg.data());
     args.push_back(nullptr);
     execv(program.c_str(), args.data());
-    std::fprintf(stderr, "defocus-bench accuracy: cannot run '%s'\n", program.c_str());
-    return 2;
+    std::fprintf(stderr, "defocus-bench: error: accuracy: cannot run '%s'\n", program.c_str());
+    return kExitBadInput;
 }
 
 } // namespace
 
 int main(int argc, char** argv)
 {
-    if (argc > 1 && std::string_view(argv[1]) == "timing")
-        return timingMain(argc - 1, argv + 1);
-    if (argc > 1 && std::string_view(argv[1]) == "plan")
-        return planMain(argc - 1, argv + 1);
-    if (argc > 1 && std::string_view(argv[1]) == "accuracy")
-        return accuracyMain(argc - 1, argv + 1, argv[0]);
     Options o;
     CLI::App app{"defocus-bench: milliseconds per pass and per frame of the defocus pipeline on the bundled TUM "
                  "clip, resized to each size; median and p90 of several runs, for a defocused and an all-in-focus "
-                 "scene. Run it from the repository root."};
+                 "scene. Run it from the repository root. The subcommands time the per-frame plan (plan), hold the "
+                 "per-pass timing baseline (timing) and sweep accuracy against a path-traced lens (accuracy); "
+                 "each has its own --help."};
+    app.set_version_flag("--version", "defocus-bench 0.1.0");
+    app.require_subcommand(0, 1);
+    defocus::TimingOptions timingOptions;
+    CLI::App* timing = declareTiming(app, timingOptions);
+    defocus::PlanOptions planOptions;
+    CLI::App* plan = declarePlan(app, planOptions);
+    CLI::App* accuracy = app.add_subcommand("accuracy", "Error against a path-traced thin lens and time per frame of "
+                                                        "every method (defocus-bench-accuracy; 'accuracy --help' "
+                                                        "lists its options)");
+    accuracy->prefix_command();
+    accuracy->set_help_flag(); // its --help is defocus-bench-accuracy's
     app.add_option("--data", o.data, "TUM RGB-D folder to take frames from")->capture_default_str();
     app.add_option("--sizes", o.sizes, "Frame sizes WIDTHxHEIGHT, comma-separated")
         ->delimiter(',')
@@ -596,7 +594,9 @@ int main(int argc, char** argv)
         ->check(CLI::IsMember({"full", "half"}));
     app.add_option("--hexagon", o.kernel, "rhombi or mcintosh [default: from --quality]")
         ->check(CLI::IsMember({"rhombi", "mcintosh"}));
-    app.add_option("--near-field", o.nearField, "true or false [default: from --quality]");
+    bool nearField = false;
+    CLI::Option* nearFieldOption = app.add_flag("--near-field,!--no-near-field", nearField,
+                                                "Spread blurred foreground over what is behind it [default: from --quality]");
     app.add_option("--focus", o.focusM, "Distance in focus, metres")->capture_default_str();
     app.add_option("--f-number", o.fNumber, "Aperture as an f-number")->capture_default_str();
     app.add_option("--focal-length", o.focalLengthMm, "Focal length, millimetres")->capture_default_str();
@@ -607,24 +607,29 @@ int main(int argc, char** argv)
     app.add_flag("--no-timers", o.noTimers, "Leave GL timer queries off, to see what timing the passes costs");
     app.add_option("--json", o.json, "Also write every run, the GL renderer and the date to this JSON file");
 
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return app.exit(e);
-    }
-    spdlog::set_pattern("%^defocus-bench: %l:%$ %v");
+    if (const auto status = cli::parse(app, argc, argv))
+        return *status;
+    cli::logToStderr("defocus-bench");
+    if (nearFieldOption->count() > 0)
+        o.nearField = nearField;
     spdlog::set_level(spdlog::level::warn); // keep the library's info lines out of the table
 
-    std::string commandLine = "defocus-bench";
-    for (int i = 1; i < argc; ++i)
-        commandLine += std::string(" ") + argv[i];
     try {
+        if (accuracy->parsed())
+            return runAccuracy(accuracy->remaining(), argv[0]);
+        if (timing->parsed())
+            return defocus::runTimingComparison(timingOptions);
+        if (plan->parsed())
+            return defocus::runPlanComparison(planOptions);
+        std::string commandLine = "defocus-bench";
+        for (int i = 1; i < argc; ++i)
+            commandLine += std::string(" ") + argv[i];
         return run(o, commandLine);
     } catch (const CLI::ValidationError& error) {
-        fmt::print(stderr, "defocus-bench: error: {}\n", error.what());
-        return kUsage;
+        spdlog::error("{}", error.what());
+        return kExitUsage;
     } catch (const std::exception& error) {
-        fmt::print(stderr, "defocus-bench: error: {}\n", error.what());
-        return kFailure;
+        spdlog::error("{}", error.what());
+        return cli::statusFor(error);
     }
 }

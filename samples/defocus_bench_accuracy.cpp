@@ -4,7 +4,7 @@
 // of the runs after warm-up) in one run, and writes a table, CSV, JSON, a Pareto plot and a
 // contact sheet of crops. A benchmark, not a test; docs/accuracy.md shows its output.
 //   defocus-bench-accuracy                               (run from the repository root)
-//   defocus-bench-accuracy --runs 9 --out out/accuracy --methods mcintosh,riguer
+//   defocus-bench-accuracy --runs 9 -o out/accuracy --methods mcintosh,riguer
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -37,6 +37,8 @@
 #include "filter/methods/Presets.hpp"
 #include "sources/ImageIO.hpp"
 #include "samples/BenchMachine.hpp"
+#include "samples/CliOptions.hpp"
+#include "samples/ExitStatus.hpp"
 #include "sources/SyntheticScene.hpp"
 
 namespace {
@@ -46,7 +48,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 /// Exit codes: 0 done, 1 runtime failure (data, GL, output), 2 bad command line.
-enum Exit { kOk = 0, kFailure = 1, kUsage = 2 };
 
 struct Options {
     std::string data = "data/blender_spheres";
@@ -56,7 +57,7 @@ struct Options {
     std::vector<std::string> methods; ///< empty: all
     bool noReference = false;
     bool noTimers = false;
-    bool saveOutputs = false; ///< write every setting's linear result to --out/outputs/*.exr
+    bool saveOutputs = false; ///< write every setting's linear result to --output/outputs/*.exr
     bool noHighlightSprites = false; ///< the rhombi without their bokeh sprites
     std::string replot; ///< accuracy.json of an earlier run: draw its Pareto plot only
     double bladeRotationDeg = 0.0; ///< the GPU methods' hexagon; 0 = a corner on top, as the truth
@@ -516,7 +517,7 @@ int replot(const Options& options)
                      {cv::IMWRITE_PNG_COMPRESSION, 9}))
         throw std::runtime_error("cannot write pareto.png");
     fmt::print("wrote {}/pareto.png from {}\n", options.out, options.replot);
-    return kOk;
+    return kExitDone;
 }
 
 int run(const Options& options, const std::string& commandLine)
@@ -765,7 +766,7 @@ int run(const Options& options, const std::string& commandLine)
     for (const auto& [kind, rect] : windows)
         fmt::print(" {} at ({},{})", kind, rect.x, rect.y);
     fmt::print(", {}x{} px)\n", windows.front().second.width, windows.front().second.height);
-    return kOk;
+    return kExitDone;
 }
 
 } // namespace
@@ -778,7 +779,7 @@ int main(int argc, char** argv)
     std::string methods;
     app.add_option("--data", options.data, "folder with color_linear.exr, depth.exr, truth_f1.4_focus5_linear.exr")
         ->capture_default_str();
-    app.add_option("--out", options.out, "output folder for CSV, JSON, pareto.png, contact_sheet.png")
+    app.add_option("-o,--output", options.out, "output folder for CSV, JSON, pareto.png, contact_sheet.png")
         ->capture_default_str();
     app.add_option("--runs", options.runs, "timed runs per setting (median reported)")
         ->check(CLI::Range(5, 1000))
@@ -797,8 +798,8 @@ int main(int argc, char** argv)
     app.add_flag("--no-highlight-sprites", options.noHighlightSprites,
                  "the rhombi without bokeh sprites for lights (what they bought)");
     app.add_flag("--save-outputs", options.saveOutputs,
-                 "also write every setting's result, linear float, to --out/outputs/LABEL.exr");
-    app.add_option("--replot", options.replot, "only redraw --out/pareto.png from an earlier run's accuracy.json");
+                 "also write every setting's result, linear float, to --output/outputs/LABEL.exr");
+    app.add_option("--replot", options.replot, "only redraw --output/pareto.png from an earlier run's accuracy.json");
     std::vector<std::string> scenes{"blender", "synthetic"};
     for (const std::string& name : syntheticSceneNames())
         scenes.push_back("synthetic:" + name);
@@ -807,7 +808,9 @@ int main(int argc, char** argv)
                    "256-sample thin-lens truth; docs/synthetic.md)")
         ->check(CLI::IsMember(scenes))
         ->capture_default_str();
-    CLI11_PARSE(app, argc, argv);
+    if (const auto status = cli::parse(app, argc, argv))
+        return *status;
+    cli::logToStderr("defocus-bench-accuracy");
 
     std::stringstream list(methods);
     for (std::string name; std::getline(list, name, ',');) {
@@ -815,7 +818,7 @@ int main(int argc, char** argv)
             continue;
         if (!findMethod(name)) {
             fmt::print(stderr, "defocus-bench-accuracy: error: --methods: no method called '{}'\n", name);
-            return kUsage;
+            return kExitUsage;
         }
         options.methods.push_back(name);
     }
@@ -826,6 +829,6 @@ int main(int argc, char** argv)
         return run(options, commandLine);
     } catch (const std::exception& error) {
         fmt::print(stderr, "defocus-bench-accuracy: error: {}\n", error.what());
-        return kFailure;
+        return cli::statusFor(error);
     }
 }

@@ -4,7 +4,6 @@
 //   defocus-preview data/tum_fr1_rpy --loop            (a recorded clip, at its own pace)
 //   defocus-preview data/tum_fr1_rpy --no-window --loop --frames 300 --no-pace  (timing only)
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cmath>
@@ -25,6 +24,8 @@
 #include "filter/Settings.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/methods/Presets.hpp"
+#include "samples/CliOptions.hpp"
+#include "samples/ExitStatus.hpp"
 #include "samples/LiveLoop.hpp"
 #include "sinks/DisplaySink.hpp"
 #include "sources/FrameSource.hpp"
@@ -32,16 +33,6 @@
 namespace {
 
 using namespace defocus;
-
-std::atomic<bool> gStop{false};
-
-extern "C" void onSignal(int)
-{
-    gStop = true;
-}
-
-/// Exit codes: 0 done, 1 runtime failure (input, display, GL), 2 bad command line, 130 stopped.
-enum Exit { kOk = 0, kFailure = 1, kUsage = 2, kInterrupted = 130 };
 
 struct Options {
     std::string input;
@@ -134,12 +125,11 @@ int run(const Options& o)
     std::uint64_t renderedRevision = std::numeric_limits<std::uint64_t>::max();
     std::string lastIssues;
     auto lastStep = LiveClock::now();
-    int exitCode = kOk;
+    int exitCode = kExitDone;
 
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
+    cli::catchStopSignals();
     try {
-        while (!controls.quit && !gStop) {
+        while (!controls.quit && !cli::stopRequested()) {
             // 1. A new frame, unless paused or at the end.
             bool fresh = false;
             feed->setPaused(controls.paused);
@@ -284,19 +274,19 @@ int run(const Options& o)
         }
     } catch (const std::exception& error) {
         spdlog::error("frame {}: {}", framesShown, error.what());
-        exitCode = kFailure;
+        exitCode = cli::statusFor(error);
     }
     feed->stop();
     if (display)
         display->finish();
-    if (gStop) {
-        spdlog::warn("stopped by signal after {} frames", framesShown);
-        if (exitCode == kOk)
-            exitCode = kInterrupted;
+    if (cli::stopRequested()) {
+        spdlog::warn("stopped by {} after {} frames", cli::stopSignal() == SIGINT ? "Ctrl-C" : "SIGTERM", framesShown);
+        if (exitCode == kExitDone)
+            exitCode = cli::stopStatus();
     }
-    if (exitCode == kOk && framesShown == 0) {
+    if (exitCode == kExitDone && framesShown == 0) {
         spdlog::error("{} gave no frames", o.input);
-        return kFailure;
+        return kExitBadInput;
     }
 
     const char* origin = captureClock ? "capture timestamp" : "read";
@@ -392,30 +382,26 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_flag("-q,--quiet", o.quiet, "Only the summary and errors");
     app.add_flag("-v,--verbose", o.verbose, "Debug logging");
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return app.exit(e);
-    }
-    spdlog::set_pattern("%^defocus-preview: %l:%$ %v");
-    spdlog::set_level(o.verbose ? spdlog::level::debug : o.quiet ? spdlog::level::warn : spdlog::level::info);
+    if (const auto status = cli::parse(app, argc, argv))
+        return *status;
+    cli::logToStderr("defocus-preview", o.quiet, o.verbose);
 
     try {
         parseResolution(o.resolution, o.quality.resolution);
         bool autoFocus = false;
         if (!parseFocus(o.focus, o.lens, autoFocus)) {
             spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);
-            return kUsage;
+            return kExitUsage;
         }
         // The command line is checked strictly, like defocus's; keys later clamp with a warning.
         const auto issues = validateCommandLine(o.lens, o.quality, autoFocus);
         for (const auto& issue : issues)
             spdlog::error("{}", issue.message);
         if (!issues.empty())
-            return kUsage;
+            return kExitUsage;
         return run(o);
     } catch (const std::exception& error) {
         spdlog::error("{}", error.what());
-        return kFailure;
+        return cli::statusFor(error);
     }
 }

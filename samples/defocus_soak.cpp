@@ -15,6 +15,7 @@
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Objects.hpp"
 #include "filter/methods/Presets.hpp"
+#include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
 
 namespace {
@@ -60,12 +61,9 @@ int main(int argc, char** argv)
     app.add_option("--quality", qualityName, "Preset the frames run with, as defocus --quality")
         ->capture_default_str()
         ->check(CLI::IsMember({"fast", "balanced", "high"}));
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        const int status = app.exit(e); // prints the message, or the help
-        return status == 0 ? kExitDone : kExitUsage;
-    }
+    if (const auto status = cli::parse(app, argc, argv))
+        return *status;
+    cli::logToStderr("defocus-soak");
 
     try {
         auto context = gl::EglContext::create();
@@ -110,11 +108,8 @@ int main(int argc, char** argv)
             return 1;
         }
         return 0;
-    } catch (const gl::ContextError& error) {
-        std::fprintf(stderr, "defocus-soak: %s\n", error.what());
-        return kExitUnavailable;
     } catch (const std::exception& error) {
-        std::fprintf(stderr, "defocus-soak: %s\n", error.what());
-        return kExitBadInput;
+        std::fprintf(stderr, "defocus-soak: error: %s\n", error.what());
+        return cli::statusFor(error);
     }
 }

@@ -14,6 +14,8 @@
 
 #include "filter/ColorSpace.hpp"
 #include "filter/gl/EglContext.hpp"
+#include "samples/CliOptions.hpp"
+#include "samples/ExitStatus.hpp"
 #include "sources/SyntheticScene.hpp"
 
 namespace {
@@ -22,7 +24,6 @@ using namespace defocus;
 namespace fs = std::filesystem;
 
 /// Exit codes: 0 done, 1 runtime failure (GL, output), 2 bad command line.
-enum Exit { kOk = 0, kFailure = 1, kUsage = 2 };
 
 void write(const fs::path& file, const cv::Mat& image)
 {
@@ -46,7 +47,7 @@ int main(int argc, char** argv)
     app.add_option("--scene", sceneName, "Scene: spheres or edges")->capture_default_str();
     app.add_option("--frame", frame, "Frame index of the shot")->capture_default_str();
     app.add_option("--frames", settings.frames, "Shot length, frames")->capture_default_str();
-    app.add_option("-o,--out", out, "Output folder: color.exr, depth.exr, reference.exr and PNG previews")
+    app.add_option("-o,--output", out, "Output folder: color.exr, depth.exr, reference.exr and PNG previews")
         ->capture_default_str();
     app.add_option("--width", settings.width, "Image width, pixels")->capture_default_str();
     app.add_option("--height", settings.height, "Image height, pixels")->capture_default_str();
@@ -69,7 +70,9 @@ int main(int argc, char** argv)
         ->capture_default_str();
     app.add_option("--runs", runs, "Render the reference this many times and print each time")->check(CLI::Range(1, 100));
     app.add_flag("--no-reference", noReference, "Only the pinhole colour and the depth");
-    CLI11_PARSE(app, argc, argv);
+    if (const auto status = cli::parse(app, argc, argv))
+        return *status;
+    cli::logToStderr("defocus-synthetic");
     parseFieldOfView(fov, settings.lens.fieldOfView); // checked by CLI11
 
     if (focus != "pull") {
@@ -77,18 +80,18 @@ int main(int argc, char** argv)
             settings.lens.focusM = std::stod(focus);
         } catch (const std::exception&) {
             fmt::print(stderr, "defocus-synthetic: --focus '{}' is neither metres nor 'pull'\n", focus);
-            return kUsage;
+            return kExitUsage;
         }
         settings.focusPull = false;
     }
     if (const auto issues = validate(settings); !issues.empty()) {
         for (const auto& issue : issues)
             fmt::print(stderr, "defocus-synthetic: {}\n", issue);
-        return kUsage;
+        return kExitUsage;
     }
     if (frame >= settings.frames) {
         fmt::print(stderr, "defocus-synthetic: --frame {} is not below --frames {}\n", frame, settings.frames);
-        return kUsage;
+        return kExitUsage;
     }
     ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0); // before OpenCV's first EXR write; a user's value wins
     try {
@@ -123,9 +126,9 @@ int main(int argc, char** argv)
         }
         fmt::print("wrote {}/color.exr, depth.exr{} (+ PNG previews)\n", out,
                    images.reference.empty() ? "" : ", reference.exr");
-        return kOk;
+        return kExitDone;
     } catch (const std::exception& error) {
         fmt::print(stderr, "defocus-synthetic: error: {}\n", error.what());
-        return kFailure;
+        return cli::statusFor(error);
     }
 }

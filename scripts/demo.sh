@@ -10,7 +10,7 @@ cd "$root"
 mkdir -p out
 # Focus on the monitor and keyboard (1 m) at f/1.4: the desk stays sharp, the person and the wall
 # behind blur with hexagonal bokeh. Frame 9 is the sharpest of the clip, so the sheet shows it.
-build/defocus data/tum_fr1_rpy -o out/tum_defocus.mp4 --focus 1.0 --f-number 1.4 \
+build/defocus data/tum_fr1_rpy -y -o out/tum_defocus.mp4 --focus 1.0 --f-number 1.4 \
   --contact-sheet out/tum_contact_sheet.png --contact-frame 9
 
 echo

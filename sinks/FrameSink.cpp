@@ -3,7 +3,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <fstream>
 #include <system_error>
+
+#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -12,30 +15,72 @@
 
 namespace defocus {
 
+namespace fs = std::filesystem;
+
+void refuseExisting(const fs::path& file, bool overwrite)
+{
+    std::error_code ec;
+    if (overwrite || !fs::exists(file, ec))
+        return;
+    if (fs::is_directory(file, ec)) {
+        if (fs::is_empty(file, ec))
+            return;
+        throw SinkError(fmt::format("output folder '{}' is not empty (-y writes into it, replacing its frames)",
+                                    file.string()));
+    }
+    throw SinkError(fmt::format("output '{}' exists (-y overwrites it)", file.string()));
+}
+
+void writeFileAtomically(const fs::path& file, const std::string& contents)
+{
+    const fs::path partial =
+        file.parent_path() / fmt::format(".{}.partial-{}", file.filename().string(), ::getpid());
+    std::error_code ec;
+    {
+        std::ofstream out(partial, std::ios::binary);
+        out << contents;
+        out.flush();
+        if (!out) {
+            fs::remove(partial, ec);
+            throw SinkError(fmt::format("cannot write '{}'", file.string()));
+        }
+    }
+    fs::rename(partial, file, ec);
+    if (ec) {
+        fs::remove(partial, ec);
+        throw SinkError(fmt::format("cannot write '{}': {}", file.string(), ec.message()));
+    }
+}
+
 std::unique_ptr<FrameSink> openSink(const SinkOptions& options)
 {
-    namespace fs = std::filesystem;
     const fs::path& output = options.output;
     if (output.empty())
         throw SinkError("no output given");
     const std::string& text = output.native();
     std::error_code ec;
-    if (text.back() == '/' || fs::is_directory(output, ec))
-        return std::make_unique<ImageSequenceSink>(output, options.linearSequence);
+    if (text.back() == '/' || fs::is_directory(output, ec)) {
+        refuseExisting(output, options.overwrite);
+        return std::make_unique<ImageSequenceSink>(output, options.linearSequence, options.fps);
+    }
+    refuseExisting(output, options.overwrite);
 
     std::string ext = output.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (ext == ".mp4" || ext == ".mkv" || ext == ".avi")
-        return std::make_unique<VideoSink>(output, options.fps);
+    if (ext == ".mp4" || ext == ".mkv" || ext == ".webm" || ext == ".avi")
+        return std::make_unique<VideoSink>(output, options.fps, options.codec);
+    if (!options.codec.empty())
+        throw SinkError(fmt::format("output '{}': --codec {} is for video outputs (.mp4, .mkv, .webm, .avi)",
+                                    output.string(), options.codec));
     if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".exr")
         return std::make_unique<SingleImageSink>(output);
     if (ext.empty())
         throw SinkError(fmt::format("output '{}' has no extension: end it with '/' for an image "
-                                    "sequence, or use .mp4, .mkv, .avi, .png, .jpg or .exr",
+                                    "sequence, or use .mp4, .mkv, .webm, .avi, .png, .jpg or .exr",
                                     output.string()));
     throw SinkError(fmt::format("output '{}': unknown extension '{}' (use a folder/, .mp4, .mkv, "
-                                ".avi, .png, .jpg or .exr)",
+                                ".webm, .avi, .png, .jpg or .exr)",
                                 output.string(), ext));
 }
 

@@ -1,15 +1,21 @@
 // The one contract every output implements: frames in display order, then finish().
-//   -o out/        numbered PNG sequence (EXR when the output is linear HDR)
-//   -o out.mp4     video (.mp4, .mkv, .avi) through cv::VideoWriter
+//   -o out/        image sequence in the TUM layout: the input's frame names, rgb.txt, depth/
+//                  depth.txt and associations.txt (PNG, or EXR when the output is linear HDR)
+//   -o out.mp4     video (.mp4 H.264, .mkv FFV1, .webm VP9, .avi) through cv::VideoWriter
 //   -o out.png     a single frame (the last one written wins); -o out.exr the same, linear float
+// An output that exists is refused (SinkError) unless SinkOptions::overwrite; every file is
+// written under a temporary name in its folder and renamed when complete.
 #pragma once
 
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <opencv2/core.hpp>
+
+#include "filter/Frame.hpp"
 
 namespace defocus {
 
@@ -31,6 +37,13 @@ public:
     virtual SinkEncoding encoding() const = 0;
     /// Writes one frame (in the encoding above). Throws SinkError on failure.
     virtual void write(const cv::Mat& image) = 0;
+    /// The same, with the input frame it was made from: sinks that keep the input's frame names
+    /// and timestamps (image sequences) use it; the others write the image alone.
+    virtual void writeFrame(const cv::Mat& image, const Frame& origin)
+    {
+        (void)origin;
+        write(image);
+    }
     /// Finalises the output (closes the video container). Idempotent; also run by the destructor.
     virtual void finish() = 0;
     /// Frames written so far.
@@ -40,16 +53,38 @@ public:
 };
 
 struct SinkOptions {
+    SinkOptions() = default;
+    SinkOptions(std::filesystem::path outputPath, double frameRate = 30.0, bool linear = false)
+        : output(std::move(outputPath)), fps(frameRate), linearSequence(linear)
+    {
+    }
+
     std::filesystem::path output;
     /// Frame rate for video containers, Hz.
     double fps = 30.0;
     /// For -o DIR/: write EXR (linear float) instead of PNG (8-bit sRGB).
     bool linearSequence = false;
+    /// Replace an output that exists (-y/--overwrite); without it, an existing file or a folder
+    /// that is not empty is refused with a SinkError naming it.
+    bool overwrite = false;
+    /// Video codec: "" = the container's default (.mp4 h264, .mkv ffv1, .webm vp9, .avi mjpg),
+    /// or one of h264, mp4v, ffv1, vp9, mjpg.
+    std::string codec;
 };
 
 /// Picks the sink from the output path: a trailing '/' or an existing directory -> sequence;
-/// .mp4/.mkv/.avi -> video; .png/.jpg -> single 8-bit frame; .exr -> single linear frame.
-/// Throws SinkError for an unknown extension or a file that cannot be created.
+/// .mp4/.mkv/.webm/.avi -> video; .png/.jpg -> single 8-bit frame; .exr -> single linear frame.
+/// Throws SinkError for an unknown extension, an output that exists without `overwrite`, or a
+/// file that cannot be created.
 std::unique_ptr<FrameSink> openSink(const SinkOptions& options);
+
+/// Throws SinkError "output 'FILE' exists (-y overwrites it)" when `file` exists (for a folder:
+/// holds anything) and `overwrite` is false. For outputs besides the main one (contact sheet,
+/// timings JSON), checked before any frame is processed.
+void refuseExisting(const std::filesystem::path& file, bool overwrite);
+
+/// Writes `contents` to `file` under a temporary name in the same folder and renames it into
+/// place, so no reader ever sees a half-written file. Throws SinkError naming the file.
+void writeFileAtomically(const std::filesystem::path& file, const std::string& contents);
 
 } // namespace defocus

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <set>
 #include <fstream>
 #include <system_error>
 #include <utility>
@@ -83,9 +86,11 @@ std::vector<int> writeParams(const std::string& ext)
     return {};
 }
 
+} // namespace
+
 // imwrite to ".NAME.partial.EXT" next to `file` (same file system, extension kept so OpenCV picks
 // the same encoder), then rename over `file`: readers never see a half-written image.
-void writeAtomically(const fs::path& file, const cv::Mat& image)
+void writeImageAtomically(const fs::path& file, const cv::Mat& image)
 {
     const std::string ext = lowerExtension(file);
     if (ext == ".exr")
@@ -111,17 +116,46 @@ void writeAtomically(const fs::path& file, const cv::Mat& image)
     }
 }
 
+namespace {
+
+bool isImageName(const fs::path& name)
+{
+    static const std::set<std::string> kImage{".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".bmp", ".ppm", ".pgm"};
+    return kImage.count(lowerExtension(name)) > 0 && !name.stem().empty();
+}
+
+// Depth in metres as TUM stores it: 16-bit, 5000 units per metre, 0 = no measurement; depths past
+// 13.1 m (the format's limit) are clamped to it.
+cv::Mat tumDepth(const cv::Mat& metres)
+{
+    cv::Mat out(metres.size(), CV_16UC1);
+    for (int y = 0; y < metres.rows; ++y)
+        for (int x = 0; x < metres.cols; ++x) {
+            const float d = metres.at<float>(y, x);
+            const bool valid = std::isfinite(d) && d > 0.0f;
+            out.at<std::uint16_t>(y, x) =
+                valid ? static_cast<std::uint16_t>(std::min(65535.0f, std::round(d * 5000.0f))) : std::uint16_t{0};
+        }
+    return out;
+}
+
 } // namespace
 
-ImageSequenceSink::ImageSequenceSink(fs::path folder, bool linear)
-    : folder_(std::move(folder)), linear_(linear)
+ImageSequenceSink::ImageSequenceSink(fs::path folder, bool linear, double fps)
+    : folder_(std::move(folder)), linear_(linear), fps_(fps > 0.0 ? fps : 30.0)
 {
     std::error_code ec;
     createdFolder_ = !fs::exists(folder_, ec);
     prepareFolder(folder_, folder_);
-    if (fs::exists(framePath(0), ec))
-        spdlog::warn("sequence '{}': the folder already holds frames; they will be overwritten",
-                     folder_.string());
+}
+
+ImageSequenceSink::~ImageSequenceSink()
+{
+    try {
+        finish();
+    } catch (const std::exception& e) {
+        spdlog::error("{}", e.what());
+    }
 }
 
 SinkEncoding ImageSequenceSink::encoding() const
@@ -131,14 +165,43 @@ SinkEncoding ImageSequenceSink::encoding() const
 
 fs::path ImageSequenceSink::framePath(std::size_t index) const
 {
-    return folder_ / fmt::format("frame_{:06}{}", index, linear_ ? ".exr" : ".png");
+    return index < entries_.size() ? folder_ / entries_[index].color : fs::path();
+}
+
+std::string ImageSequenceSink::nameFor(const Frame& origin)
+{
+    const fs::path name(origin.name);
+    std::string stem = isImageName(name) ? name.stem().string() : std::string();
+    if (stem.empty() || used_.count(stem) > 0)
+        stem = fmt::format("frame_{:06}", written_);
+    used_.insert(stem);
+    return stem;
 }
 
 void ImageSequenceSink::write(const cv::Mat& image)
 {
-    const fs::path file = framePath(written_);
+    Frame origin;
+    origin.index = written_;
+    writeFrame(image, origin);
+}
+
+void ImageSequenceSink::writeFrame(const cv::Mat& image, const Frame& origin)
+{
+    if (finished_)
+        throw SinkError(fmt::format("cannot write sequence '{}': already finished", folder_.string()));
+    const std::string stem = nameFor(origin);
+    Entry entry{origin.timestamp > 0.0 ? origin.timestamp : static_cast<double>(written_) / fps_,
+                stem + (linear_ ? ".exr" : ".png"), {}};
+    const fs::path file = folder_ / entry.color;
     checkFrame(image, encoding(), file);
-    writeAtomically(file, image);
+    if (!origin.depth.empty() && origin.depth.type() == CV_32FC1) {
+        entry.depth = "depth/" + stem + ".png";
+        std::error_code ec;
+        fs::create_directories(folder_ / "depth", ec);
+        writeImageAtomically(folder_ / entry.depth, tumDepth(origin.depth));
+    }
+    writeImageAtomically(file, image);
+    entries_.push_back(entry);
     ++written_;
 }
 
@@ -148,15 +211,38 @@ void ImageSequenceSink::finish()
         return;
     finished_ = true;
     std::error_code ec;
-    if (written_ == 0 && createdFolder_ && fs::is_empty(folder_, ec) && fs::remove(folder_, ec))
-        spdlog::warn("sequence '{}': no frames written, so the folder it created is removed",
-                     folder_.string());
+    if (written_ == 0) {
+        if (createdFolder_ && fs::is_empty(folder_, ec) && fs::remove(folder_, ec))
+            spdlog::warn("sequence '{}': no frames written, so the folder it created is removed",
+                         folder_.string());
+        return;
+    }
+    const auto list = [&](const char* what, auto line) {
+        std::string text = fmt::format("# {}\n# file: written by defocus\n# timestamp {}\n", what,
+                                       std::string(what) == "associations" ? "rgb timestamp depth" : "filename");
+        for (const Entry& e : entries_)
+            if (const std::string l = line(e); !l.empty())
+                text += l + "\n";
+        return text;
+    };
+    writeFileAtomically(folder_ / "rgb.txt",
+                        list("color images", [](const Entry& e) { return fmt::format("{:.6f} {}", e.timestamp, e.color); }));
+    const bool anyDepth = std::any_of(entries_.begin(), entries_.end(), [](const Entry& e) { return !e.depth.empty(); });
+    if (!anyDepth)
+        return;
+    writeFileAtomically(folder_ / "depth.txt", list("depth maps", [](const Entry& e) {
+                            return e.depth.empty() ? std::string() : fmt::format("{:.6f} {}", e.timestamp, e.depth);
+                        }));
+    writeFileAtomically(folder_ / "associations.txt", list("associations", [](const Entry& e) {
+                            return e.depth.empty() ? std::string()
+                                                   : fmt::format("{:.6f} {} {:.6f} {}", e.timestamp, e.color,
+                                                                 e.timestamp, e.depth);
+                        }));
 }
 
 std::string ImageSequenceSink::describe() const
 {
-    return fmt::format("{} sequence '{}' (frame_NNNNNN{}, {} frames)", linear_ ? "EXR" : "PNG",
-                       folder_.string(), linear_ ? ".exr" : ".png", written_);
+    return fmt::format("{} sequence '{}' (TUM layout, {} frames)", linear_ ? "EXR" : "PNG", folder_.string(), written_);
 }
 
 SingleImageSink::SingleImageSink(fs::path file) : file_(std::move(file))
@@ -176,7 +262,7 @@ SingleImageSink::SingleImageSink(fs::path file) : file_(std::move(file))
 void SingleImageSink::write(const cv::Mat& image)
 {
     checkFrame(image, encoding_, file_);
-    writeAtomically(file_, image);
+    writeImageAtomically(file_, image);
     ++written_;
 }
 

@@ -32,17 +32,36 @@ std::string lowerExtension(const fs::path& file)
     return ext;
 }
 
-// In order of preference. mp4v (MPEG-4 Part 2) and MJPG are built into FFmpeg itself; X264 needs
-// libx264, so .mkv falls back to mp4v and then lossless FFV1.
-std::vector<std::string> codecsFor(const std::string& ext)
+struct Codec {
+    const char* name;   ///< --codec NAME
+    const char* fourcc; ///< what cv::VideoWriter is asked for
+};
+
+// avc1 is H.264 through FFmpeg's libx264 (Debian's FFmpeg has it); FFV1 is FFmpeg's lossless
+// intra codec; VP90 is libvpx's VP9 (OpenCV's FFmpeg wrapper prints that it maps the tag for
+// WebM, then writes VP9: a line on stderr it prints itself).
+const std::vector<Codec> kCodecs{{"h264", "avc1"}, {"mp4v", "mp4v"}, {"ffv1", "FFV1"}, {"vp9", "VP90"}, {"mjpg", "MJPG"}};
+
+// The container's default first, then what it falls back to when that encoder is missing.
+std::vector<std::string> defaultCodecsFor(const std::string& ext)
 {
     if (ext == ".mp4")
-        return {"mp4v"};
-    if (ext == ".avi")
-        return {"MJPG"};
+        return {"h264", "mp4v"};
     if (ext == ".mkv")
-        return {"X264", "mp4v", "FFV1"};
+        return {"ffv1"};
+    if (ext == ".webm")
+        return {"vp9"};
+    if (ext == ".avi")
+        return {"mjpg"};
     return {};
+}
+
+const Codec* findCodec(const std::string& name)
+{
+    for (const Codec& codec : kCodecs)
+        if (name == codec.name)
+            return &codec;
+    return nullptr;
 }
 
 std::string joined(const std::vector<std::string>& items)
@@ -55,14 +74,21 @@ std::string joined(const std::vector<std::string>& items)
 
 } // namespace
 
-VideoSink::VideoSink(fs::path file, double fps) : file_(std::move(file)), fps_(fps)
+VideoSink::VideoSink(fs::path file, double fps, const std::string& codec) : file_(std::move(file)), fps_(fps)
 {
     const std::string ext = lowerExtension(file_);
-    const std::vector<std::string> codecs = codecsFor(ext);
+    std::vector<std::string> codecs = defaultCodecsFor(ext);
     if (codecs.empty())
         throw SinkError(fmt::format("cannot write video '{}': unsupported container '{}' (use "
-                                    ".mp4, .mkv or .avi)",
+                                    ".mp4, .mkv, .webm or .avi)",
                                     file_.string(), ext));
+    if (!codec.empty()) {
+        if (!findCodec(codec))
+            throw SinkError(fmt::format("cannot write video '{}': unknown codec '{}' (use h264, mp4v, ffv1, vp9 "
+                                        "or mjpg)",
+                                        file_.string(), codec));
+        codecs = {codec};
+    }
     if (!(fps_ > 0.0) || !std::isfinite(fps_))
         throw SinkError(fmt::format("cannot write video '{}': the frame rate must be positive, "
                                     "got {}",
@@ -80,23 +106,24 @@ VideoSink::VideoSink(fs::path file, double fps) : file_(std::move(file)), fps_(f
                                     file_.string(), dir.string()));
 
     for (const std::string& candidate : codecs) {
+        const std::string fourcc = findCodec(candidate)->fourcc;
         cv::VideoWriter writer;
-        const bool opened = openWriter(writer, candidate, probeSize);
+        const bool opened = openWriter(writer, fourcc, probeSize);
         writer.release();
         fs::remove(partial_, ec);
         if (opened) {
-            codec_ = candidate;
+            codec_ = fourcc;
+            codecName_ = candidate;
             break;
         }
-        spdlog::debug("video '{}': codec {} does not open here", file_.string(), candidate);
+        spdlog::debug("video '{}': codec {} ({}) does not open here", file_.string(), candidate, fourcc);
     }
     if (codec_.empty())
-        throw SinkError(fmt::format("cannot write video '{}': no encoder opens for codec {} "
-                                    "(OpenCV's FFmpeg lacks it)",
-                                    file_.string(), joined(codecs)));
-    if (codec_ != codecs.front())
-        spdlog::info("video '{}': codec {} unavailable, using {}", file_.string(), codecs.front(),
-                     codec_);
+        throw SinkError(fmt::format("cannot write video '{}': no encoder opens for codec {} in a {} file "
+                                    "(OpenCV's FFmpeg lacks it, or the container cannot hold it)",
+                                    file_.string(), joined(codecs), ext));
+    if (codecName_ != codecs.front())
+        spdlog::warn("video '{}': codec {} unavailable, using {}", file_.string(), codecs.front(), codecName_);
 }
 
 VideoSink::~VideoSink()
@@ -172,7 +199,8 @@ void VideoSink::finish()
 
 std::string VideoSink::describe() const
 {
-    return fmt::format("video '{}' ({}, {:g} fps, {} frames)", file_.string(), codec_, fps_, written_);
+    return fmt::format("video '{}' ({} ({}), {:g} fps, {} frames)", file_.string(), codecName_, codec_, fps_,
+                       written_);
 }
 
 } // namespace defocus

@@ -1,5 +1,8 @@
-// Video output through cv::VideoWriter (FFmpeg): .mp4 as MPEG-4 Part 2 (mp4v), .avi as Motion
-// JPEG, .mkv as H.264 when an encoder exists.   defocus data/tum_fr1_rpy -o out.mp4
+// Video output through cv::VideoWriter (FFmpeg): .mp4 as H.264 (avc1, plays in browsers), .mkv
+// as lossless FFV1, .webm as VP9, .avi as Motion JPEG; --codec h264|mp4v|ffv1|vp9|mjpg picks
+// another.   defocus data/tum_fr1_rpy -o out.mp4      defocus in/ -o out.mkv (lossless)
+// OpenCV 4.6 passes no quality or bit-rate setting to these encoders (VIDEOWRITER_PROP_QUALITY
+// is read by its MJPEG writer only), so there is none here: each codec runs at FFmpeg's default.
 #pragma once
 
 #include <cstddef>
@@ -14,11 +17,11 @@ namespace defocus {
 
 class VideoSink final : public FrameSink {
 public:
-    /// Picks the codec for the container and proves at once that it opens (a tiny probe file,
-    /// deleted again), so that a missing encoder or an unwritable folder fails before any frame
-    /// is processed. Frames go to NAME.partial.EXT, renamed to `file` by finish().
-    /// Throws SinkError naming the file and the codecs tried.
-    VideoSink(std::filesystem::path file, double fps);
+    /// Picks the codec (`codec` by name, or the container's default) and proves at once that it
+    /// opens (a tiny probe file, deleted again), so that a missing encoder or an unwritable folder
+    /// fails before any frame is processed. Frames go to NAME.partial.EXT, renamed to `file` by
+    /// finish(). Throws SinkError naming the file and the codecs tried.
+    VideoSink(std::filesystem::path file, double fps, const std::string& codec = {});
     ~VideoSink() override;
     VideoSink(const VideoSink&) = delete;
     VideoSink& operator=(const VideoSink&) = delete;
@@ -33,7 +36,7 @@ public:
     std::size_t framesWritten() const override { return written_; }
     std::string describe() const override;
 
-    /// FourCC in use, e.g. "mp4v".
+    /// FourCC in use, e.g. "avc1".
     const std::string& codec() const { return codec_; }
 
 private:
@@ -42,7 +45,8 @@ private:
     std::filesystem::path file_;
     std::filesystem::path partial_;
     double fps_;
-    std::string codec_;
+    std::string codec_;     ///< FourCC, e.g. "avc1"
+    std::string codecName_; ///< --codec name, e.g. "h264"
     cv::VideoWriter writer_;
     cv::Size size_;
     std::size_t written_ = 0;

@@ -39,6 +39,17 @@ bool isVideoFile(const fs::path& file)
 
 } // namespace
 
+double defaultDepthScale(const SourceOptions& options)
+{
+    std::error_code ec;
+    const fs::path& input = options.input;
+    if (fs::is_directory(input, ec) && (fs::exists(input / "rgb.txt", ec) || fs::exists(input / "associations.txt", ec)))
+        return tumUnitsPerMetre;
+    if (options.depth && options.depth->extension() == ".txt")
+        return tumUnitsPerMetre;
+    return defaultUnitsPerMetre;
+}
+
 std::unique_ptr<FrameSource> openSource(const SourceOptions& options)
 {
     const fs::path& input = options.input;

@@ -38,6 +38,13 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// A device that exists but is in use by another program (a camera another process captures
+/// from): trying again later may work, so the programs exit with 75 (ExitStatus.hpp), not 1.
+class DeviceBusy : public SourceError {
+public:
+    using SourceError::SourceError;
+};
+
 class FrameSource {
 public:
     virtual ~FrameSource() = default;
@@ -72,6 +79,11 @@ struct SourceOptions {
     /// Frame rate asked of a camera, Hz (> 0); the driver picks the nearest it has.
     double fps = 30.0;
 };
+
+/// The units per metre openSource reads 16-bit depth at when `options.depthScale` is unset: 5000
+/// (TUM's) for a folder in the TUM layout and for a depth list (.txt), 1000 (millimetres) for
+/// everything else. README "Depth scales" says why the TUM layout keeps 5000.
+double defaultDepthScale(const SourceOptions& options);
 
 /// Opens the source that `options.input` names; throws SourceError with a clear message when
 /// it does not exist or cannot be recognised.

@@ -146,7 +146,7 @@ void V4l2Source::openDevice()
             throw SourceError(fmt::format("no permission to open camera {} (is the user in the "
                                           "'video' group?)", dev));
         case EBUSY:
-            throw SourceError(fmt::format("camera {} is busy (another program is capturing from it)", dev));
+            throw DeviceBusy(fmt::format("camera {} is busy (another program is capturing from it)", dev));
         default:
             throw SourceError(fmt::format("cannot open camera {}: {}", dev, errorText(error)));
         }
@@ -280,10 +280,13 @@ void V4l2Source::setFormat(std::uint32_t fourcc, const std::vector<std::uint32_t
     format.fmt.pix.field = V4L2_FIELD_NONE;
     if (xioctl(fd_, VIDIOC_S_FMT, &format) != 0) {
         const int error = errno;
-        throw SourceError(fmt::format("camera {} ({}): VIDIOC_S_FMT {} {}x{} failed: {}{}", dev, card_,
-                                      v4l2::fourccName(fourcc), options_.width, options_.height,
-                                      errorText(error),
-                                      error == EBUSY ? " (another program is capturing from it)" : ""));
+        const std::string message = fmt::format("camera {} ({}): VIDIOC_S_FMT {} {}x{} failed: {}{}", dev, card_,
+                                                v4l2::fourccName(fourcc), options_.width, options_.height,
+                                                errorText(error),
+                                                error == EBUSY ? " (another program is capturing from it)" : "");
+        if (error == EBUSY)
+            throw DeviceBusy(message);
+        throw SourceError(message);
     }
     const v4l2_pix_format& got = format.fmt.pix;
     // Drivers may answer S_FMT with another format without an error (vivid gives YUYV when asked

@@ -85,11 +85,12 @@ TEST_F(BadInputCliGLTest, BrokenFrameMidClipKeepsTheSequenceBeforeIt)
                                                (dir / "depth").string(), (dir / "out").string()));
     EXPECT_EQ(r.exitCode, 1) << r.output;
     EXPECT_NE(r.output.find((dir / "rgb" / "3.png").string()), std::string::npos) << r.output;
-    EXPECT_EQ(fileNames(dir / "out"),
-              (std::vector<std::string>{"frame_000000.png", "frame_000001.png", "frame_000002.png"}))
+    // The input's frame names, listed: the sequence is a TUM folder of the frames before the bad one.
+    EXPECT_EQ(fileNames(dir / "out"), (std::vector<std::string>{"0.png", "1.png", "2.png", "associations.txt", "depth",
+                                                               "depth.txt", "rgb.txt"}))
         << r.output;
     for (int k = 0; k < 3; ++k)
-        EXPECT_EQ(cv::imread((dir / "out" / fmt::format("frame_{:06}.png", k)).string()).size(), cv::Size(64, 48));
+        EXPECT_EQ(cv::imread((dir / "out" / fmt::format("{}.png", k)).string()).size(), cv::Size(64, 48));
 }
 
 TEST_F(BadInputCliGLTest, BrokenFirstFrameLeavesNoOutputAtAll)

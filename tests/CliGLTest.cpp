@@ -1,5 +1,5 @@
-// The defocus program end to end: Ctrl-C (SIGINT) and SIGTERM finalise what was written, and
-// every input frame gives an output frame.
+// The defocus program end to end: Ctrl-C (SIGINT) and SIGTERM finalise what was written, every
+// input frame gives an output frame, frames and focus chosen over time, and the depth-scale warning.
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -8,12 +8,15 @@
 #include <string>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include "samples/FocusSchedule.hpp"
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"
 
@@ -115,7 +118,7 @@ TEST_P(Interrupt, VideoWrittenSoFarIsFinalisedAndPlayable)
                                 out.string(), "--focus", "1"},
                                GetParam(), [&] { return fs::exists(partial) && fs::file_size(partial) > 20000; },
                                out.parent_path() / "log.txt");
-    EXPECT_EQ(run.exitCode, 130) << run.output;
+    EXPECT_EQ(run.exitCode, GetParam() == SIGINT ? 130 : 143) << run.output; // 128 + the signal, as shells report it
     ASSERT_TRUE(fs::exists(out)) << run.output;
     EXPECT_FALSE(fs::exists(partial));
     const long written = framesOut(run.output);
@@ -144,6 +147,64 @@ TEST_F(Cli, EveryInputFrameGivesAnOutputFrame)
     for (const auto& e : fs::directory_iterator(out / "frames"))
         files += e.path().extension() == ".png" ? 1 : 0;
     EXPECT_EQ(files, 10);
+}
+
+// Defect caught: --start/--every taking the wrong frames, or keyed focus evaluated at the wrong
+// time (frame index instead of the clip's timestamps) or not eased: the focus of every frame out
+// is held against FocusSchedule at that frame's TUM timestamp.
+TEST_F(Cli, StartEveryAndKeyedFocusPerFrame)
+{
+    const fs::path out = test::scratchDir("cli_keyed");
+    const ProgramRun run = runDefocus({(test::dataDir() / "tum_fr1_rpy").string(), "-o", (out / "frames/").string(), "-q",
+                                       "--start", "2", "--every", "3", "--focus", "0s:1,0.3s:2.5", "--explain"},
+                                      0, [] { return true; }, out / "log.txt");
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("3 frames in, 3 frames out"), std::string::npos) << run.output;
+    std::ifstream list(test::dataDir() / "tum_fr1_rpy" / "rgb.txt");
+    std::vector<double> times;
+    for (std::string line; std::getline(list, line);)
+        if (!line.empty() && line[0] != '#')
+            times.push_back(std::stod(line));
+    const FocusSchedule pull = FocusSchedule::parse("0s:1,0.3s:2.5");
+    for (const std::size_t index : {2u, 5u, 8u}) {
+        const std::string want = fmt::format("frame {}: focus {:.4f} m", index, pull.focusAt(times[index] - times[0]));
+        EXPECT_NE(run.output.find(want), std::string::npos) << want << "\n" << run.output;
+    }
+    EXPECT_EQ(run.output.find("frame 3: focus"), std::string::npos) << run.output;
+}
+
+// Defect caught: a clip in the TUM layout whose depth is in millimetres (as RealSense recorders
+// write it) read at TUM's 5000 units per metre without a word: every depth 5x too near.
+TEST_F(Cli, MillimetreClipInTumLayoutWarnsWithTheFix)
+{
+    const fs::path clip = test::scratchDir("cli_millimetres");
+    const fs::path tum = test::dataDir() / "tum_fr1_rpy";
+    for (const char* list : {"rgb.txt", "depth.txt", "associations.txt"})
+        fs::copy_file(tum / list, clip / list);
+    fs::create_directory_symlink(tum / "rgb", clip / "rgb");
+    fs::create_directories(clip / "depth");
+    for (const auto& e : fs::directory_iterator(tum / "depth")) {
+        const cv::Mat units = cv::imread(e.path().string(), cv::IMREAD_UNCHANGED);
+        cv::Mat millimetres;
+        units.convertTo(millimetres, CV_16U, 1000.0 / 5000.0);
+        cv::imwrite((clip / "depth" / e.path().filename()).string(), millimetres);
+    }
+    const fs::path out = test::scratchDir("cli_millimetres_out");
+    const ProgramRun warned = runDefocus({clip.string(), "-o", (out / "a.png").string(), "--frames", "1"}, 0,
+                                         [] { return true; }, out / "log.txt");
+    EXPECT_EQ(warned.exitCode, 0) << warned.output;
+    EXPECT_NE(warned.output.find("defocus: warning: depth of "), std::string::npos) << warned.output;
+    EXPECT_NE(warned.output.find("at 5000 units per metre"), std::string::npos) << warned.output;
+    EXPECT_NE(warned.output.find("add --depth-scale 1000"), std::string::npos) << warned.output;
+    const ProgramRun fixed = runDefocus({clip.string(), "-o", (out / "b.png").string(), "--frames", "1", "--depth-scale",
+                                         "1000"},
+                                        0, [] { return true; }, out / "log2.txt");
+    EXPECT_EQ(fixed.exitCode, 0) << fixed.output;
+    EXPECT_EQ(fixed.output.find("units per metre"), std::string::npos) << fixed.output;
+    // The bundled clip itself, at its own scale, passes quietly.
+    const ProgramRun tumRun = runDefocus({tum.string(), "-o", (out / "c.png").string(), "--frames", "1"}, 0,
+                                         [] { return true; }, out / "log3.txt");
+    EXPECT_EQ(tumRun.output.find("units per metre"), std::string::npos) << tumRun.output;
 }
 
 } // namespace

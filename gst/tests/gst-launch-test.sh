@@ -24,7 +24,7 @@ grep -q "Klass  *Filter/Effect/Video" "$work/inspect.txt" || fail "classificatio
 
 # 2. The bundled clip through gst-launch-1.0, numbered as multifilesrc needs (the TUM files are
 # named by timestamp), paired as the CLI pairs them (associations.txt).
-mkdir -p "$work/rgb" "$work/depth" "$work/gst" "$work/cli"
+mkdir -p "$work/rgb" "$work/depth"
 i=0
 while read -r _ rgb _ depth; do
   n=$(printf %06d $i)
@@ -38,17 +38,23 @@ for variant in "balanced" "high --hexagon mcintosh"; do
   read -r preset extra <<<"$variant"
   props="autofocus=false focus=1.0 f-number=1.4 depth-scale=5000 quality=$preset"
   [ -n "${extra:-}" ] && props="$props hexagon=mcintosh"
-  rm -f "$work"/gst/* "$work"/cli/*
+  rm -rf "$work/gst" "$work/cli" "$work/cli-seq" && mkdir -p "$work/gst" "$work/cli-seq"
   gst-launch-1.0 -q defocus name=d $props ! videoconvert ! pngenc ! multifilesink location="$work/gst/%06d.png" \
     multifilesrc location="$work/rgb/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! d.color \
     multifilesrc location="$work/depth/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! d.depth \
     || fail "the pipeline failed ($variant)"
   "$cli" "$root/data/tum_fr1_rpy" -o "$work/cli/" $lens --quality $preset ${extra:-} -q >/dev/null
+  # The CLI's frames keep the clip's TUM names, in rgb.txt's order; numbered links for multifilesrc.
+  n=0
+  grep -v '^#' "$work/cli/rgb.txt" | while read -r _ file; do
+    ln -s "$work/cli/$file" "$work/cli-seq/$(printf %06d $n).png"
+    n=$((n + 1))
+  done
   [ "$(ls "$work/gst" | wc -l)" -eq "$frames" ] || fail "the pipeline gave $(ls "$work/gst" | wc -l) frames, not $frames"
   # Both sets decoded to raw RGB by the same decoder: the pixels must be the same bytes.
   gst-launch-1.0 -q multifilesrc location="$work/gst/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! \
     videoconvert ! video/x-raw,format=RGB ! filesink location="$work/gst.rgb"
-  gst-launch-1.0 -q multifilesrc location="$work/cli/frame_%06d.png" caps=image/png,framerate=30/1 ! pngdec ! \
+  gst-launch-1.0 -q multifilesrc location="$work/cli-seq/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! \
     videoconvert ! video/x-raw,format=RGB ! filesink location="$work/cli.rgb"
   [ -s "$work/cli.rgb" ] || fail "no CLI frames decoded"
   cmp -s "$work/gst.rgb" "$work/cli.rgb" || fail "gst-launch-1.0 frames differ from the CLI's ($variant)"
