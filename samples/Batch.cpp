@@ -525,16 +525,35 @@ std::size_t removePartialOutput(const fs::path& output)
         return fs::remove(path, error) ? 1 : 0;
     if (!fs::is_directory(path, error))
         return 0;
-    // A folder output: only the numbered frames a sequence sink writes (frame_NNNNNN.png/.exr).
+    // A folder output (TUM layout): the files its lists name, the lists, and files still under a
+    // temporary name (".NAME.partial.EXT"); then depth/ and the folder when that empties them.
     std::size_t removed = 0;
-    for (const auto& entry : fs::directory_iterator(path, error)) {
-        const std::string name = entry.path().filename().string();
-        const std::string ext = entry.path().extension().string();
-        if (name.rfind("frame_", 0) == 0 && (ext == ".png" || ext == ".exr") && entry.is_regular_file(error))
-            removed += fs::remove(entry.path(), error) ? 1 : 0;
+    const auto remove = [&](const fs::path& file) {
+        if (fs::is_regular_file(file, error) && fs::remove(file, error))
+            ++removed;
+    };
+    for (const char* list : {"rgb.txt", "depth.txt"}) {
+        std::ifstream in(path / list);
+        for (std::string line; std::getline(in, line);) {
+            if (line.empty() || line.front() == '#')
+                continue;
+            std::istringstream fields(line);
+            std::string timestamp, name;
+            if (fields >> timestamp >> name && name.find("..") == std::string::npos && name.front() != '/')
+                remove(path / name);
+        }
     }
-    if (fs::is_empty(path, error))
-        fs::remove(path, error);
+    for (const char* list : {"rgb.txt", "depth.txt", "associations.txt"})
+        remove(path / list);
+    for (const fs::path& folder : {path / "depth", path})
+        for (const auto& entry : fs::directory_iterator(folder, error)) {
+            const std::string name = entry.path().filename().string();
+            if (name.front() == '.' && name.find(".partial.") != std::string::npos)
+                remove(entry.path());
+        }
+    for (const fs::path& folder : {path / "depth", path})
+        if (fs::is_directory(folder, error) && fs::is_empty(folder, error))
+            fs::remove(folder, error);
     return removed;
 }
 

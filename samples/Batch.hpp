@@ -115,8 +115,9 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
              const std::function<ClipRunner(std::size_t worker)>& makeWorker,
              const std::function<int()>& stopStatus);
 
-/// Removes what a clip that did not finish left at `output`: a file, or a folder output's
-/// numbered frames (and the folder, when it is left empty). Never throws; returns what it removed.
+/// Removes what a clip that did not finish left at `output`: a file, or a folder output's frames
+/// (those its rgb.txt and depth.txt name, the lists, files under a temporary name) and the folder
+/// when that empties it; other files stay. Never throws; returns how many files it removed.
 std::size_t removePartialOutput(const std::filesystem::path& output);
 
 } // namespace defocus::batch

@@ -18,7 +18,9 @@ tmp=$(mktemp -d /tmp/defocus-batch.XXXXXX)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
 tum="$root/data/tum_fr1_rpy"
-frames_on_disk() { ls "$1" 2>/dev/null | grep -c '^frame_'; }
+# Frames of a folder output (TUM layout: the input's frame names, .png), not counting depth/ or
+# files under a temporary name.
+frames_on_disk() { find "$1" -maxdepth 1 -name '[!.]*.png' 2>/dev/null | wc -l; }
 
 # ---- 1. GNU parallel, two shards --------------------------------------------------------------
 {
@@ -42,8 +44,8 @@ done
 grep -q '"status": "failed"' out/missing.report.json || fail "the missing clip's report does not say failed"
 grep -q "no-such-clip" out/missing.report.json || fail "the missing clip's report does not name its input"
 grep -q '"exit_status": 1' out/missing.report.json || fail "the missing clip's report does not give exit status 1"
-for f in out/same-a/frame_*; do
-  cmp -s "$f" "out/same-b/$(basename "$f")" || fail "$f differs from its twin: the same clip rendered twice differs"
+for f in out/same-a/*.png out/same-a/depth/*.png out/same-a/*.txt; do
+  cmp -s "$f" "out/same-b/${f#out/same-a/}" || fail "$f differs from its twin: the same clip rendered twice differs"
 done
 cmp -s out/c.mp4 out/d.mp4 || fail "out/c.mp4 and out/d.mp4 (the same clip and settings) differ"
 grep -q '"renderer"' out/c.mp4.report.json || fail "the report does not name the renderer"

@@ -42,7 +42,7 @@ work=$(mktemp -d /tmp/defocus-container.XXXXXX)
 cp -r "$root/data/tum_fr1_rpy" "$work/"
 printf 'tum_fr1_rpy\t-\tout/clip/\t--frames 2 --focus 1.0 --quality fast\n' > "$work/clips.tsv"
 run -v "$work:/work" -w /work "$image" --batch clips.tsv || fail "defocus --batch failed in the image"
-[ "$(ls "$work/out/clip" | grep -c '^frame_')" -eq 2 ] || fail "the batch in the image wrote no 2 frames"
+[ "$(find "$work/out/clip" -maxdepth 1 -name '[!.]*.png' | wc -l)" -eq 2 ] || fail "the batch in the image wrote no 2 frames"
 grep -q '"status": "done"' "$work/out/clip.report.json" || fail "no done report from the image"
 size=$("${pod[@]}" image inspect "$image" --format '{{.Size}}')
 rm -rf "$work"

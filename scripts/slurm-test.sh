@@ -110,6 +110,8 @@ for k in 0 1 2 3 4 5; do
 done
 
 cd "$tmp/work"
+# Frames of a folder output (TUM layout: the input's frame names), not files under a temporary name.
+frames_on_disk() { find "$1" -maxdepth 1 -name '[!.]*.png' 2>/dev/null | wc -l; }
 job=$(DEFOCUS="$defocus" sbatch --parsable --array=0-1 --cpus-per-task=1 --time=10 \
   --output="$tmp/work/task-%a.log" "$root/scripts/defocus.sbatch" "$manifest" -q) ||
   fail "sbatch refused the job"
@@ -118,7 +120,7 @@ echo "slurm-test: submitted array job $job"
 # Cancel task 1 once clip 3 has frames on disk but no report.
 cancelled=""
 for _ in $(seq 600); do
-  n=$(ls out/clip3 2>/dev/null | grep -c '^frame_')
+  n=$(frames_on_disk out/clip3)
   if [ "$n" -ge 2 ] && [ ! -e out/clip3.report.json ]; then
     scancel "${job}_1" && cancelled=1
     echo "slurm-test: cancelled task 1 with $n frames of clip 3 written"
@@ -135,7 +137,7 @@ for _ in $(seq 600); do [ "$(state 1)" = CANCELLED ] && break; sleep 0.1; done
 [ "$(state 1)" = CANCELLED ] || fail "task 1 is $(state 1), not CANCELLED"
 [ "$(exitcode 1)" = 143 ] || fail "task 1 exited $(exitcode 1), not 143 (SIGTERM, clip finalised)"
 [ -e out/clip3.report.json ] && fail "the cancelled clip 3 has a report"
-left=$(ls out/clip3 2>/dev/null | grep -c '^frame_')
+left=$(frames_on_disk out/clip3)
 [ "$left" -eq 0 ] || fail "the cancelled clip 3 left $left frames that look like output"
 [ -e out/clip1.report.json ] || fail "clip 1, finished before the cancel, has no report"
 
@@ -157,7 +159,7 @@ for k in 0 1 2 3 4 5; do
   [ -f "$report" ] || fail "clip $k has no report"
   grep -q '"status": "done"' "$report" || fail "clip $k's report does not say done: $(head -c 300 "$report")"
   grep -q "\"frames_out\": ${frames[$k]}," "$report" || fail "clip $k's report does not count ${frames[$k]} frames out"
-  on_disk=$(ls "out/clip$k" | grep -c '^frame_')
+  on_disk=$(frames_on_disk "out/clip$k")
   [ "$on_disk" -eq "${frames[$k]}" ] || fail "clip $k has $on_disk frames on disk, not ${frames[$k]}"
   done_lines=$(cat task-*.log | grep -c "defocus: clip $k (out/clip$k/): done")
   [ "$done_lines" -eq 1 ] || fail "clip $k was done $done_lines times"

@@ -210,23 +210,30 @@ TEST(Reports, BuildInfoNamesVersionAndCommit)
 }
 
 // Defect: a stopped clip's frames left where they look like a finished output, or files that
-// are not the sink's frames (the user's own) removed with them.
+// are not the sink's (the user's own) removed with them.
 TEST(PartialOutput, RemovesTheClipsFilesOnly)
 {
     const fs::path dir = test::scratchDir("BatchPartial");
     std::ofstream(dir / "clip.mp4") << "x";
     EXPECT_EQ(removePartialOutput(dir / "clip.mp4"), 1u);
     EXPECT_FALSE(fs::exists(dir / "clip.mp4"));
-    fs::create_directories(dir / "seq");
-    std::ofstream(dir / "seq" / "frame_000000.png") << "x";
-    std::ofstream(dir / "seq" / "frame_000001.png") << "x";
-    EXPECT_EQ(removePartialOutput(dir / "seq/"), 2u);
-    EXPECT_FALSE(fs::exists(dir / "seq"));
+    // A TUM-layout folder as the sequence sink finalises it after a stop: two frames listed, one
+    // still under its temporary name.
+    const fs::path seq = dir / "seq";
+    fs::create_directories(seq / "depth");
+    for (const char* name : {"1.5.png", "2.5.png", "depth/1.5.png", "depth/2.5.png", ".3.5.partial.png"})
+        std::ofstream(seq / name) << "x";
+    std::ofstream(seq / "rgb.txt") << "# color images\n1.5 1.5.png\n2.5 2.5.png\n";
+    std::ofstream(seq / "depth.txt") << "# depth maps\n1.5 depth/1.5.png\n2.5 depth/2.5.png\n";
+    std::ofstream(seq / "associations.txt") << "1.5 1.5.png 1.5 depth/1.5.png\n";
+    EXPECT_EQ(removePartialOutput(dir / "seq/"), 8u);
+    EXPECT_FALSE(fs::exists(seq));
     fs::create_directories(dir / "mixed");
-    std::ofstream(dir / "mixed" / "frame_000000.exr") << "x";
-    std::ofstream(dir / "mixed" / "notes.txt") << "x";
-    EXPECT_EQ(removePartialOutput(dir / "mixed"), 1u);
-    EXPECT_TRUE(fs::exists(dir / "mixed" / "notes.txt"));
+    std::ofstream(dir / "mixed" / "0.png") << "x";
+    std::ofstream(dir / "mixed" / "rgb.txt") << "0 0.png\n";
+    std::ofstream(dir / "mixed" / "notes.png") << "x";
+    EXPECT_EQ(removePartialOutput(dir / "mixed"), 2u);
+    EXPECT_TRUE(fs::exists(dir / "mixed" / "notes.png"));
     EXPECT_EQ(removePartialOutput(dir / "nothing.mp4"), 0u);
 }
 
