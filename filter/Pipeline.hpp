@@ -1,5 +1,11 @@
-// The McIntosh hexagonal-bokeh chain: upload -> CoC -> blur 0 deg -> blur +-120 deg -> min().
-// Owns every intermediate target and reallocates them only when size or format changes.
+// The depth-of-field pipeline for one frame: a frame whose valid depths all give less than half a
+// pixel of CoC is passed through before anything else; otherwise depth hole filling, upload, the
+// scene analysis on the GPU and the per-frame plan (which tiles blur, which are copied, whether
+// the near field, highlights and sprites run), the CoC pass, the blurs (QualitySettings::kernel:
+// two passes of one-sided lines summed into three rhombi, the default, or McIntosh et al.'s three
+// directional blurs and the min() of two), at full or half size (half: a prefilter and an upscale
+// that puts the frame's in-focus pixels back), bokeh sprites for lights above white, and the view
+// read back. Owns every intermediate target and reallocates them only when size or format changes.
 // Needs a current GL 4.5 context (gl::EglContext) for its whole life.
 #pragma once
 

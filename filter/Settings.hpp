@@ -132,10 +132,10 @@ struct QualitySettings {
 /// What the pipeline writes out. The first five are the McIntosh lab's modes 1-5.
 enum class View {
     Input,      ///< 1: the colour the blur starts from (after the CoC pass)
-    Horizontal, ///< 2: after the 0 degree blur
-    DiagonalA,  ///< 3: horizontal result blurred at +120 degrees
-    DiagonalB,  ///< 4: horizontal result blurred at -120 degrees
-    Composite,  ///< 5: min(A, B), the depth-of-field result
+    Horizontal, ///< 2: after the first blur (McIntosh: along an edge; rhombi: X, the first line)
+    DiagonalA,  ///< 3: that blurred at +120 degrees (rhombi: A, one rhombus)
+    DiagonalB,  ///< 4: that blurred at -120 degrees (rhombi: B, two rhombi averaged)
+    Composite,  ///< 5: the depth-of-field result (rhombi: (A + 2B) / 3; McIntosh: min(A, B))
     Depth,      ///< filled depth, colour-mapped, with a legend
     Coc         ///< signed CoC (near < 0 < far), colour-mapped, with a legend
 };

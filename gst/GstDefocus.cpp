@@ -5,6 +5,7 @@
 //     filesrc location=clip.mp4 ! decodebin ! videoconvert ! d.color
 //     filesrc location=depth.png ! pngdec ! imagefreeze ! d.depth         (one line)
 #include "gst/GstDefocus.hpp"
+#include "gst/GstDefocusSrc.hpp"
 
 #include <atomic>
 #include <cmath>
@@ -784,7 +785,8 @@ static void gst_defocus_init(GstDefocus* self)
 
 static gboolean plugin_init(GstPlugin* plugin)
 {
-    return gst_element_register(plugin, "defocus", GST_RANK_NONE, GST_TYPE_DEFOCUS);
+    return gst_element_register(plugin, "defocus", GST_RANK_NONE, GST_TYPE_DEFOCUS) &&
+           gst_element_register(plugin, "defocussrc", GST_RANK_NONE, GST_TYPE_DEFOCUS_SRC);
 }
 
 #define PACKAGE "defocus"

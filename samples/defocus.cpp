@@ -32,9 +32,11 @@
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
 #include "samples/FocusSchedule.hpp"
+#include "samples/NewestFrameSource.hpp"
 #include "samples/Progress.hpp"
 #include "sinks/FrameSink.hpp"
 #include "sinks/ImageSinks.hpp"
+#include "sinks/V4l2OutputSink.hpp"
 #include "sources/DepthScale.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/SyntheticSource.hpp"
@@ -278,6 +280,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     std::map<std::string, double> passMs;
     double totalMs = 0, uploadMs = 0, readbackMs = 0;
     std::size_t framesIn = 0, timed = 0;
+    bool sheetWritten = false;
     std::size_t current = 0; // index of the frame being read or processed, for messages
 
     int status = kExitDone;
@@ -328,6 +331,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
                                    drawTileMap(tiles.front().second, pipeline.plan(), pipeline.analysis()));
                 writeImageAtomically(options.contactSheet, contactSheet(tiles));
                 pipeline.run(*frame, lens, options.quality, view, encoding); // keep timings of a plain frame
+                sheetWritten = true;
             }
             sink.writeFrame(image, *frame);
             frameSize = image.size();
@@ -365,6 +369,9 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         passMs[pass.name] += pass.ms;
     if (!options.timings.empty() && framesIn > 0)
         timingLog.write(options.timings, gl.context.info().glRenderer, frameSize);
+    if (!options.contactSheet.empty() && !sheetWritten && status == kExitDone && !cli::stopRequested())
+        spdlog::warn("--contact-frame {} is beyond the {} frames read: no contact sheet written to {}",
+                     options.contactFrame, framesIn, options.contactSheet);
     if (cli::stopRequested()) {
         spdlog::warn("stopped by {} after {} frames; {} is finalised", cli::stopSignal() == SIGINT ? "Ctrl-C" : "SIGTERM",
                      framesIn, options.output);
@@ -423,9 +430,20 @@ int runClip(Options options, std::optional<GlSession>& gl, nlohmann::json* repor
     sinkOptions.overwrite = options.overwrite;
     sinkOptions.codec = options.codec;
     auto sink = openSink(sinkOptions);
+    // A camera to a virtual camera: never make the camera wait, drop what the filter cannot keep up with.
+    NewestFrameSource* newest = nullptr;
+    if (source->isLive() && dynamic_cast<V4l2OutputSink*>(sink.get())) {
+        auto feed = std::make_unique<NewestFrameSource>(std::move(source), [] { return cli::stopRequested(); });
+        newest = feed.get();
+        source = std::move(feed);
+    }
     if (!options.quiet)
         spdlog::info("{} -> {} on {}", source->describe(), options.output, gl->context.info().glRenderer);
-    return processClip(options, *source, demo, *sink, *gl, report);
+    const int status = processClip(options, *source, demo, *sink, *gl, report);
+    if (newest && !options.quiet)
+        spdlog::info("live: {} frames captured, {} dropped (the filter was slower than the camera)",
+                     newest->captured(), newest->dropped());
+    return status;
 }
 
 /// The command line, bound to `o`.

@@ -500,21 +500,30 @@ int run(const Options& options, const std::string& commandLine)
 
 namespace {
 
-/// `defocus-bench timing`: the per-pass timing baseline and comparator (samples/BenchTiming.hpp).
+/// `defocus-bench timing`: the per-preset timing baseline and comparator (samples/BenchTiming.hpp).
 CLI::App* declareTiming(CLI::App& app, defocus::TimingOptions& o)
 {
-    CLI::App* sub = app.add_subcommand("timing", "Each pass's GPU time over a calibration pass measured in the same run, "
-                                                 "written as a baseline or compared with one (exit 1 on a regression)");
+    CLI::App* sub = app.add_subcommand("timing", "For each preset, the frame's wall time (with readback) and each "
+                                                 "pass's GPU time over a calibration pass measured in the same run, "
+                                                 "written as a baseline or compared with one");
     sub->add_option("--data", o.data, "TUM RGB-D folder to take frames from")->capture_default_str();
-    sub->add_option("--baseline", o.baseline, "Compare with this baseline JSON; exit 1 on a regression");
+    sub->add_option("--baseline", o.baseline,
+                    "Compare with this baseline JSON; exit 1 on a regression, a missing or renamed preset or pass, "
+                    "or a frame all in focus");
     sub->add_option("--write-baseline", o.writeBaseline, "Write the measured ratios to this JSON file");
-    sub->add_option("--quality", o.preset, "Preset whose passes are timed: fast, balanced or high")
-        ->check(CLI::IsMember({"fast", "balanced", "high"}))
-        ->capture_default_str();
-    sub->add_option("--runs", o.runs, "Measured frames")->capture_default_str()->check(CLI::Range(3, 10000));
-    sub->add_option("--max-ratio", o.maxRatio, "Largest allowed growth of a pass's ratio over the baseline")
+    sub->add_option("--quality", o.presets, "Presets timed, comma-separated: fast, balanced, high [default: all]")
+        ->delimiter(',')
+        ->check(CLI::IsMember({"fast", "balanced", "high"}));
+    sub->add_option("--runs", o.runs, "Measured frames per preset")->capture_default_str()->check(CLI::Range(3, 10000));
+    sub->add_option("--max-ratio", o.maxRatio, "Largest allowed growth of a preset's frame ratio over the baseline's")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
+    sub->add_option("--f-number", o.fNumber, "Lens of the timed frames (50 mm focused at 1 m): f-number")
+        ->capture_default_str()
+        ->check(CLI::Range(0.7, 64.0));
+    sub->add_option("--max-coc", o.maxCocPx, "Largest blur diameter, pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 512.0));
     return sub;
 }
 

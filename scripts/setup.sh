@@ -17,6 +17,7 @@ packages=(
   libcli11-dev             # command-line parsing
   libfmt-dev libspdlog-dev # formatting and logging
   nlohmann-json3-dev       # JSON timings and benchmark output
+  jq                       # scripts/figures.sh: docs/figures.json
   libgtest-dev libgmock-dev googletest   # tests
   libbenchmark-dev         # micro-benchmarks
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev   # the GStreamer element (gst/)

@@ -48,7 +48,6 @@ layout(std140, binding = 0) uniform RhombusBlurParams {
     vec4 directions;       // xy, zw: texture-space offset per pixel along this pass's two lines
     vec4 across;           // pass 2: texture-space offset half a pixel across each line, or 0
     vec2 baseSteps;        // pixels: the step of each line that moves one pixel on its major axis
-    int unusedMaxTaps;     // MAX_TAPS is a #define of the program variant
     int nearTileSize;      // pixels per tile of uNearDiameter
     float bleedingBias;    // the paper's unit: CoC as a fraction of the image height
     float bleedingMult;

@@ -1,4 +1,5 @@
-// openSink: picks the sink from the output path (folder/, video container or image file).
+// openSink: picks the sink from the output path (folder/, video container, image file or
+// /dev/video* virtual camera).
 #include "sinks/FrameSink.hpp"
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "sinks/ImageSinks.hpp"
+#include "sinks/V4l2OutputSink.hpp"
 #include "sinks/VideoSink.hpp"
 
 namespace defocus {
@@ -58,6 +60,8 @@ std::unique_ptr<FrameSink> openSink(const SinkOptions& options)
     if (output.empty())
         throw SinkError("no output given");
     const std::string& text = output.native();
+    if (isV4l2DevicePath(output))
+        return std::make_unique<V4l2OutputSink>(output, options.fps);
     std::error_code ec;
     if (text.back() == '/' || fs::is_directory(output, ec)) {
         refuseExisting(output, options.overwrite);

@@ -3,6 +3,7 @@
 //                  depth.txt and associations.txt (PNG, or EXR when the output is linear HDR)
 //   -o out.mp4     video (.mp4 H.264, .mkv FFV1, .webm VP9, .avi) through cv::VideoWriter
 //   -o out.png     a single frame (the last one written wins); -o out.exr the same, linear float
+//   -o /dev/video10  a virtual camera (v4l2loopback), YUYV
 // An output that exists is refused (SinkError) unless SinkOptions::overwrite; every file is
 // written under a temporary name in its folder and renamed when complete.
 #pragma once
@@ -73,7 +74,8 @@ struct SinkOptions {
 };
 
 /// Picks the sink from the output path: a trailing '/' or an existing directory -> sequence;
-/// .mp4/.mkv/.webm/.avi -> video; .png/.jpg -> single 8-bit frame; .exr -> single linear frame.
+/// .mp4/.mkv/.webm/.avi -> video; .png/.jpg -> single 8-bit frame; .exr -> single linear frame;
+/// /dev/video* -> a V4L2 output device (V4l2OutputSink.hpp; an existing device is never refused).
 /// Throws SinkError for an unknown extension, an output that exists without `overwrite`, or a
 /// file that cannot be created.
 std::unique_ptr<FrameSink> openSink(const SinkOptions& options);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs defocus into a temporary prefix, builds tests/consumer against it twice (CMake package,
 # then pkg-config) and checks that each consumer's PNG of one bundled frame is the same file, byte
-# for byte, as the command line's with the same settings.
+# for byte, as the command line's with the same settings; and that the GStreamer plugin is installed
+# where GStreamer finds it, loading the installed library.
 #   tests/install-test.sh BUILD_DIR DEFOCUS_CLI [PRESET]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -35,4 +36,23 @@ for mode in cmake pkg-config; do
     status=1
   fi
 done
+
+# The GStreamer plugin (when the build has it): installed in LIBDIR/gstreamer-1.0 beside the
+# library, loading the installed libdefocus, and found there by GStreamer with both its elements.
+if [ -e "$build/gst/libgstdefocus.so" ]; then
+  plugin=$(find "$work/prefix" -name libgstdefocus.so)
+  library=$(find "$work/prefix" -name 'libdefocus.so.*' | head -n 1)
+  if [ -z "$plugin" ] || [ "$(dirname "$plugin")" != "$(dirname "$library")/gstreamer-1.0" ]; then
+    echo "install-test: libgstdefocus.so is at '$plugin', not in $(dirname "$library")/gstreamer-1.0"
+    exit 1
+  fi
+  lib=$(ldd "$plugin" | awk '/libdefocus/ {print $3}')
+  case "$lib" in "$work/prefix/"*) ;; *) echo "install-test: the installed plugin loads '$lib', not the installed library"; exit 1 ;; esac
+  for element in defocus defocussrc; do
+    GST_PLUGIN_PATH="$(dirname "$plugin")" GST_REGISTRY="$work/registry.bin" gst-inspect-1.0 "$element" \
+      >"$work/inspect.txt" 2>&1 || { echo "install-test: GStreamer does not find $element in the install"; exit 1; }
+    grep -q "Filename *$plugin" "$work/inspect.txt" || { echo "install-test: $element is not loaded from $plugin"; exit 1; }
+  done
+  echo "install-test: the GStreamer plugin is in $(dirname "$plugin") and GStreamer finds defocus and defocussrc there"
+fi
 exit $status

@@ -34,8 +34,8 @@ const std::vector<Preset>& presets()
     // half of the time of the same kernel at full size. fast: the same at 4 taps, which saves
     // little on llvmpipe (above) but more where the blur passes dominate (a GPU, 4K). high: where
     // the front flattens at full size. McIntosh's chain as published (16 taps, flat top)
-    // measured 30.27 dB; the presets all use the rhombi, which keep the hexagon, and a
-    // highlight's energy, from preset to preset.
+    // measures 30.55 dB (tests/AccuracyGLTest, docs/figures.md); the presets all use the rhombi,
+    // which keep the hexagon, and a highlight's energy, from preset to preset.
     //
     // 32F, not 16F: on llvmpipe the full-float targets ran as fast or faster in nearly every row
     // at the same accuracy (within 0.01 dB), half floats being converted in software on every

@@ -91,7 +91,7 @@ const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, L
                                             LineMode line3, int taps, bool fused, bool unrolled)
 {
     if (first)
-        line3 = LineMode::Point; // unused
+        line3 = LineMode::Point; // pass 1 has no third line: one program whatever the caller passed
     const int key = (first ? 1 : 0) | (near ? 2 : 0) | (tiles ? 4 : 0) | static_cast<int>(line1) << 3 |
                     static_cast<int>(line2) << 5 | (fused ? 1 << 7 : 0) | taps << 8 | static_cast<int>(line3) << 16 |
                     (unrolled ? 1 << 18 : 0);
@@ -99,10 +99,11 @@ const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, L
     if (slot.id() == 0) {
         std::vector<std::string> defines{fmt::format("LINE1_MODE {}", static_cast<int>(line1)),
                                          fmt::format("LINE2_MODE {}", static_cast<int>(line2)),
-                                         fmt::format("LINE3_MODE {}", static_cast<int>(line3)),
                                          fmt::format("MAX_TAPS {}", taps)};
         if (first)
             defines.emplace_back("FIRST_PASS 1");
+        else
+            defines.emplace_back(fmt::format("LINE3_MODE {}", static_cast<int>(line3)));
         if (near)
             defines.emplace_back("NEAR_FIELD 1");
         if (fused)
@@ -112,7 +113,8 @@ const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, L
         const std::string name = fmt::format("rhombus_blur{}{}{}{} {}{}{} x{}{}", first ? " first" : " second",
                                              fused ? " fused" : "", near ? " near" : "", tiles ? " tiles" : "",
                                              static_cast<int>(line1), static_cast<int>(line2),
-                                             static_cast<int>(line3), taps, unrolled ? " unrolled" : "");
+                                             first ? std::string() : std::to_string(static_cast<int>(line3)), taps,
+                                             unrolled ? " unrolled" : "");
         slot = gl::Program(tiles ? "tiles.vert" : "fullscreen.vert", "rhombus_blur.frag", name, defines);
     }
     return slot;

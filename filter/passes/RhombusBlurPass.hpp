@@ -59,7 +59,6 @@ private:
         float directions[4];
         float across[4];
         float baseSteps[2]; ///< std140: the ints follow the vec2 directly
-        int unusedMaxTaps;
         int nearTileSize;
         float bleedingBias;
         float bleedingMult;
@@ -75,7 +74,8 @@ private:
     };
     static LineModes lineModes(const Directions& directions);
     /// The program of one variant, compiled on first use: pass, near field, tiles, line modes
-    /// (`line3`: pass 2 only).
+    /// (`line3`, u3 over X: pass 2 only; pass 1 programs ignore it). The taps are MAX_TAPS, a
+    /// #define of the variant.
     const gl::Program& program(bool first, bool near, bool tiles, LineMode line1, LineMode line2, LineMode line3,
                                int taps, bool fused, bool unrolled);
     std::map<int, gl::Program> programs_;

@@ -1,6 +1,8 @@
 // The whole public API of libdefocus: find_package(defocus) + target defocus::defocus, or
-// pkg-config defocus. See Filter.hpp for the filter and Settings.hpp for what it takes.
+// pkg-config defocus. See Filter.hpp for the filter, Settings.hpp for what it takes and Source.hpp
+// for reading the inputs the command line reads.
 #pragma once
 
 #include "defocus/Filter.hpp"
 #include "defocus/Settings.hpp"
+#include "defocus/Source.hpp"

@@ -1,0 +1,90 @@
+// defocus::Source: the command line's inputs as a stream of colour + depth frames, for programs
+// that want to read what `defocus INPUT` reads (GStreamer's defocussrc is one).
+//   defocus::Source source({"data/tum_fr1_rpy"});        // TUM folder: depth in metres, 5000 units/m
+//   while (auto frame = source.next()) filter.process(frame->color, frame->depth, frame->timestampS);
+//
+// Inputs, as the command line takes them: a TUM RGB-D folder (rgb.txt + depth.txt, files named by
+// timestamp), a folder of colour images with `depth` a folder (paired by sorted name) or one file,
+// one image with one depth image, a video file with a depth folder or TUM depth list, and a V4L2
+// camera (/dev/videoN) with `depth` a depth image or a Z16 depth camera (/dev/videoM).
+// Threads: a Source is used from one thread at a time; it makes no GL context.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "defocus/Export.hpp"
+#include "defocus/Filter.hpp"
+
+namespace defocus {
+
+/// A frame that cannot be read, or an input that does not exist or is not recognised: what()
+/// is the command line's message, naming the file or device.
+class DEFOCUS_API SourceReadError : public InputError {
+public:
+    using InputError::InputError;
+};
+
+struct SourceSettings {
+    /// What `defocus INPUT` takes: a folder, an image, a video file or /dev/videoN.
+    std::string input;
+    /// --depth: a folder, an image, a TUM depth list or a Z16 camera; empty where the input names
+    /// its own depth (TUM) or has none (the frames pass through in focus).
+    std::string depth;
+    /// --depth-scale: units per metre of 16-bit depth images, > 0. Unset: 5000 for TUM folders,
+    /// 1000 otherwise.
+    std::optional<double> depthScale;
+    /// A camera is asked for this size (pixels) and rate (Hz); it answers with the nearest it has.
+    int width = 640;
+    int height = 480;
+    double fps = 30.0;
+};
+
+/// One frame as the source gives it.
+struct SourceFrame {
+    /// BGR, CV_8UC3 sRGB-encoded, or CV_32FC3 scene-linear (EXR and other float inputs).
+    cv::Mat color;
+    /// Metres along the view axis, CV_32FC1, its own size; 0 = no measurement; empty = no depth.
+    cv::Mat depth;
+    /// Capture time, seconds, on the source's clock (file names, TUM lists, a camera's
+    /// CLOCK_MONOTONIC); 0 where unknown.
+    double timestampS = 0.0;
+    /// Frames since the start, from 0.
+    std::size_t index = 0;
+    /// Where it came from, for messages, e.g. "rgb/1305031102.175304.png".
+    std::string name;
+};
+
+class DEFOCUS_API Source {
+public:
+    /// Opens the input; throws SourceReadError with the command line's message when it does not
+    /// exist or cannot be recognised.
+    explicit Source(const SourceSettings& settings);
+    ~Source();
+    Source(Source&&) noexcept;
+    Source& operator=(Source&&) noexcept;
+    Source(const Source&) = delete;
+    Source& operator=(const Source&) = delete;
+
+    /// The next frame; nullopt at the end. Throws SourceReadError when a frame cannot be read
+    /// (a camera unplugged, a corrupt file); the stream may not be resumed after that.
+    std::optional<SourceFrame> next();
+    /// Frames in the input when known in advance (recorded inputs).
+    std::optional<std::size_t> frameCount() const;
+    /// Nominal rate, Hz; 0 when unknown.
+    double frameRate() const;
+    /// A camera (frames come in real time and do not end by themselves).
+    bool isLive() const;
+    /// One line: kind and location, e.g. "TUM RGB-D sequence data/tum_fr1_rpy (44 pairs)".
+    std::string describe() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace defocus

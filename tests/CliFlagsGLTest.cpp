@@ -1,0 +1,750 @@
+// Every option that `defocus --help` lists, through the binary: each test runs the program on a
+// tiny frame (161x121, the bundled TUM texture over depth planes made for the test) and checks
+// that the option changes the picture or the report the way its help line says, and the rules by
+// which explicit options override --quality. The last test holds the list of options against
+// --help, so that an option added without a test fails the suite.
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "tests/GLTestSupport.hpp"
+#include "tests/TestSupport.hpp"
+
+namespace defocus {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kWidth = 161, kHeight = 121; // odd, so that half size has to round
+constexpr int kSplit = 80;                 // the depth planes meet at this column
+constexpr int kMargin = 24;                // beyond any blur of these tests (16 px) and a tile
+
+struct Ran {
+    int exitCode = -1;
+    std::string out; ///< stdout
+    std::string err; ///< stderr
+};
+
+std::string readText(const fs::path& file)
+{
+    std::ifstream in(file);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+class CliFlags : public test::GLTest {
+protected:
+    static fs::path dir_;
+
+    /// The fixtures, made once: colour.png (the TUM texture), depth planes (16-bit PNG, 1000 units
+    /// per metre), a point and a light as float EXR, and a 2-frame folder pair.
+    static void SetUpTestSuite()
+    {
+        GLTest::SetUpTestSuite();
+        // One folder per process: CTest runs each test in a process of its own, side by side.
+        dir_ = test::scratchDir(fmt::format("cli_flags/{}", ::getpid()));
+        std::vector<fs::path> rgb;
+        for (const auto& e : fs::directory_iterator(test::dataDir() / "tum_fr1_rpy" / "rgb"))
+            rgb.push_back(e.path());
+        std::sort(rgb.begin(), rgb.end());
+        cv::Mat texture;
+        cv::resize(cv::imread(rgb.front().string()), texture, {kWidth, kHeight}, 0, 0, cv::INTER_AREA);
+        cv::imwrite((dir_ / "colour.png").string(), texture);
+
+        const auto planes = [](int leftMm, int rightMm, cv::Size size = {kWidth, kHeight}) {
+            cv::Mat depth(size, CV_16UC1, cv::Scalar(rightMm));
+            depth.colRange(0, std::min(kSplit, size.width)).setTo(leftMm);
+            return depth;
+        };
+        cv::imwrite((dir_ / "far.png").string(), planes(3000, 3000));         // all at 3 m
+        cv::imwrite((dir_ / "near_far.png").string(), planes(600, 3000));     // 0.6 m | 3 m
+        cv::imwrite((dir_ / "near_focus.png").string(), planes(600, 1000));   // 0.6 m | 1 m
+        cv::imwrite((dir_ / "focus_far.png").string(), planes(1000, 3000));   // 1 m | 3 m
+        cv::imwrite((dir_ / "far81.png").string(), planes(3000, 3000, {81, 81}));
+
+        // One pixel of linear 1.0 (white, not above it) on black, for the hexagon's shape and energy.
+        cv::Mat point(81, 81, CV_32FC3, cv::Scalar::all(0));
+        point.at<cv::Vec3f>(40, 40) = {1.0f, 1.0f, 1.0f};
+        EXPECT_TRUE(cv::imwrite((dir_ / "point.exr").string(), point));
+        // A light 30 times white on grey: bokeh sprites' input.
+        cv::Mat light(81, 81, CV_32FC3, cv::Scalar::all(0.2));
+        light(cv::Rect(39, 39, 3, 3)).setTo(cv::Scalar::all(30.0));
+        EXPECT_TRUE(cv::imwrite((dir_ / "light.exr").string(), light));
+        // 8-bit colour with a clipped light, for --highlight-gain.
+        cv::Mat clipped(81, 81, CV_8UC3, cv::Scalar::all(60));
+        clipped(cv::Rect(38, 38, 5, 5)).setTo(cv::Scalar::all(255));
+        cv::imwrite((dir_ / "clipped.png").string(), clipped);
+
+        fs::create_directories(dir_ / "clip" / "rgb");
+        fs::create_directories(dir_ / "clip" / "depth");
+        cv::Mat flipped;
+        cv::flip(texture, flipped, 1);
+        cv::imwrite((dir_ / "clip" / "rgb" / "0.png").string(), texture);
+        cv::imwrite((dir_ / "clip" / "rgb" / "1.png").string(), flipped);
+        cv::imwrite((dir_ / "clip" / "depth" / "0.png").string(), planes(600, 3000));
+        cv::imwrite((dir_ / "clip" / "depth" / "1.png").string(), planes(600, 3000));
+        // The same colour over a depth that jumps from 1 m to 3 m at the second frame.
+        fs::create_directories(dir_ / "jump" / "depth");
+        fs::create_symlink(dir_ / "clip" / "rgb", dir_ / "jump" / "rgb");
+        cv::imwrite((dir_ / "jump" / "depth" / "0.png").string(), planes(1000, 1000));
+        cv::imwrite((dir_ / "jump" / "depth" / "1.png").string(), planes(3000, 3000));
+    }
+
+    static void TearDownTestSuite()
+    {
+        if (::testing::UnitTest::GetInstance()->failed_test_count() == 0)
+            fs::remove_all(dir_); // kept when something failed, to look at
+    }
+
+    static fs::path file(const std::string& name) { return dir_ / name; }
+
+    /// Runs defocus with `arguments` (quoted for the shell), stdout and stderr apart.
+    static Ran defocus(const std::string& arguments)
+    {
+        static int count = 0;
+        const fs::path out = dir_ / fmt::format("run{}.stdout", count);
+        const fs::path err = dir_ / fmt::format("run{}.stderr", count++);
+        const std::string command = fmt::format("'{}/defocus' {} >'{}' 2>'{}'", DEFOCUS_BINARY_DIR, arguments,
+                                                out.string(), err.string());
+        const int status = std::system(command.c_str());
+        return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readText(out), readText(err)};
+    }
+
+    /// The picture `arguments` give, written to a fresh file of type `extension` (".png": 8-bit
+    /// sRGB, ".exr": linear float); an empty Mat (and a failure) when the run fails.
+    static cv::Mat render(const std::string& arguments, const std::string& extension = ".png")
+    {
+        static int count = 0;
+        const fs::path output = dir_ / fmt::format("out{}{}", count++, extension);
+        const Ran run = defocus(arguments + " -q -o '" + output.string() + "'");
+        EXPECT_EQ(run.exitCode, 0) << arguments << "\n" << run.err;
+        return cv::imread(output.string(), cv::IMREAD_UNCHANGED);
+    }
+
+    /// The TUM texture over depth `depth` (one of the planes above), --focus 1 unless set.
+    static cv::Mat texture(const std::string& depth, const std::string& options,
+                           const std::string& extension = ".png")
+    {
+        return render(fmt::format("'{}' --depth '{}' {}", file("colour.png").string(), file(depth).string(),
+                                  options.find("--focus") == std::string::npos ? "--focus 1 " + options : options),
+                      extension);
+    }
+
+    static cv::Mat input() { return cv::imread(file("colour.png").string()); }
+};
+
+fs::path CliFlags::dir_;
+
+/// Mean absolute difference per channel value, over `roi` (all of it when empty).
+double difference(const cv::Mat& a, const cv::Mat& b, cv::Rect roi = {})
+{
+    if (a.empty() || b.empty() || a.size() != b.size())
+        return -1.0;
+    if (roi.area() == 0)
+        roi = cv::Rect({0, 0}, a.size());
+    cv::Mat da, db;
+    a(roi).convertTo(da, CV_64F);
+    b(roi).convertTo(db, CV_64F);
+    const cv::Scalar m = cv::mean(cv::abs(da - db));
+    return (m[0] + m[1] + m[2]) / 3.0;
+}
+
+bool identical(const cv::Mat& a, const cv::Mat& b)
+{
+    return !a.empty() && a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+}
+
+const cv::Rect kLeft(0, 0, kSplit - kMargin, kHeight);
+const cv::Rect kRight(kSplit + kMargin, 0, kWidth - kSplit - kMargin, kHeight);
+
+// --- the lens --------------------------------------------------------------------------------
+
+// Defect: --focal-length ignored or inverted. A point at 3 m, focus 1 m, f/1.4 on 36 mm over
+// 161 px: 35 mm blurs it by about 2.6 px, 50 mm by 5.3 px, 85 mm by 15 px.
+TEST_F(CliFlags, FocalLengthLongerLensBlursMore)
+{
+    const cv::Mat in = input();
+    const double mm35 = difference(texture("far.png", "--f-number 1.4 --focal-length 35"), in);
+    const double mm50 = difference(texture("far.png", "--f-number 1.4 --focal-length 50"), in);
+    const double mm85 = difference(texture("far.png", "--f-number 1.4 --focal-length 85"), in);
+    EXPECT_LT(mm35, mm50);
+    EXPECT_LT(mm50, mm85);
+}
+
+// Defect: --sensor-width ignored, or multiplied where it divides (px = mm x width / sensor width).
+TEST_F(CliFlags, SensorWidthSmallerSensorBlursMore)
+{
+    const cv::Mat in = input();
+    const double w24 = difference(texture("far.png", "--f-number 1.4 --sensor-width 24"), in);
+    const double w36 = difference(texture("far.png", "--f-number 1.4 --sensor-width 36"), in);
+    const double w72 = difference(texture("far.png", "--f-number 1.4 --sensor-width 72"), in);
+    EXPECT_GT(w24, w36);
+    EXPECT_GT(w36, w72);
+}
+
+// Defect: --fov-from ignored, or the two conventions swapped. With the field of view of the focal
+// length the same blur spans (S - f) / S as many pixels as with the sensor at the image distance:
+// 0.8 at 100 mm focused at 0.5 m, and no difference at infinity.
+TEST_F(CliFlags, FovFromImageDistanceBlursMoreUnlessFocusedAtInfinity)
+{
+    const cv::Mat in = input();
+    const std::string lens = "--focus 0.5 --focal-length 100 --f-number 2.8 --max-coc 64";
+    const double image = difference(texture("far.png", lens + " --fov-from image-distance"), in);
+    const double focal = difference(texture("far.png", lens + " --fov-from focal-length"), in);
+    EXPECT_GT(image, focal * 1.05) << "image-distance " << image << ", focal-length " << focal;
+    EXPECT_TRUE(identical(texture("far.png", "--focus inf --f-number 1.4 --fov-from image-distance"),
+                          texture("far.png", "--focus inf --f-number 1.4 --fov-from focal-length")));
+}
+
+// Defect: --coc-model ignored (focal-range runs the thin lens). The focal-range model does not
+// know the aperture: its picture is the same at f/1.4 and f/8, the thin lens's is not.
+TEST_F(CliFlags, CocModelFocalRangeIgnoresTheAperture)
+{
+    const std::string range = "--coc-model focal-range --near 0.5 --far 6 --max-coc 16";
+    const cv::Mat rangeOpen = texture("near_far.png", range + " --f-number 1.4");
+    EXPECT_TRUE(identical(rangeOpen, texture("near_far.png", range + " --f-number 8")));
+    const cv::Mat thinOpen = texture("near_far.png", "--coc-model thin-lens --max-coc 16 --f-number 1.4");
+    EXPECT_FALSE(identical(thinOpen, texture("near_far.png", "--coc-model thin-lens --max-coc 16 --f-number 8")));
+    EXPECT_FALSE(identical(rangeOpen, thinOpen));
+}
+
+// Defects: --near ignored, applied to the far side, or used by the thin lens. Moving the near
+// limit towards the focus blurs the near plane (0.6 m) more and leaves the far plane's pixels
+// (3 m, beyond the near blur's reach) unchanged; the thin lens does not read it.
+TEST_F(CliFlags, NearMovesOnlyTheNearBlur)
+{
+    const cv::Mat in = input();
+    const std::string range = "--coc-model focal-range --far 6 --max-coc 16";
+    const cv::Mat loose = texture("near_far.png", range + " --near 0.3"); // 0.6 m: 9 px
+    const cv::Mat tight = texture("near_far.png", range + " --near 0.5"); // 0.6 m: 13 px
+    EXPECT_GT(difference(tight, in, kLeft), difference(loose, in, kLeft) + 0.5);
+    EXPECT_EQ(difference(tight, loose, kRight), 0.0);
+    EXPECT_TRUE(identical(texture("near_far.png", "--f-number 2 --near 0.3"),
+                          texture("near_far.png", "--f-number 2 --near 0.5")));
+}
+
+// Defects: --far ignored, applied to the near side, or used by the thin lens.
+TEST_F(CliFlags, FarMovesOnlyTheFarBlur)
+{
+    const cv::Mat in = input();
+    const std::string range = "--coc-model focal-range --near 0.3 --max-coc 16";
+    const cv::Mat loose = texture("near_far.png", range + " --far 6");   // 3 m: 6.4 px
+    const cv::Mat tight = texture("near_far.png", range + " --far 3.5"); // 3 m: 12.8 px
+    EXPECT_GT(difference(tight, in, kRight), difference(loose, in, kRight) + 0.5);
+    EXPECT_EQ(difference(tight, loose, kLeft), 0.0);
+    EXPECT_TRUE(identical(texture("near_far.png", "--f-number 2 --far 3.5"),
+                          texture("near_far.png", "--f-number 2 --far 6")));
+}
+
+// Defect: --max-coc ignored (no clamp) or clamping to the wrong value: at f/1.4 and 85 mm the far
+// plane's 15 px is clamped to 4 px and 8 px; above 15 px the clamp changes nothing.
+TEST_F(CliFlags, MaxCocClampsTheBlur)
+{
+    const cv::Mat in = input();
+    const std::string lens = "--f-number 1.4 --focal-length 85";
+    const double c4 = difference(texture("far.png", lens + " --max-coc 4"), in);
+    const double c8 = difference(texture("far.png", lens + " --max-coc 8"), in);
+    EXPECT_LT(c4, c8);
+    EXPECT_TRUE(identical(texture("far.png", lens + " --max-coc 32"), texture("far.png", lens + " --max-coc 64")));
+}
+
+// Defect: --blade-rotation ignored. A point's hexagon with a corner on top (0) has a narrow top
+// row; rotated by 30 degrees an edge is on top, as wide as a side (half the 21 px diameter).
+TEST_F(CliFlags, BladeRotationPutsACornerOrAnEdgeOnTop)
+{
+    const auto topRowWidth = [&](const std::string& rotation) {
+        const cv::Mat out =
+            render(fmt::format("'{}' --depth '{}' --coc-model focal-range --focus 1 --near 0.5 --far 2 --max-coc 21 --quality "
+                               "high --no-highlight-sprites --blade-rotation {}",
+                               file("point.exr").string(), file("far81.png").string(), rotation),
+                   ".exr");
+        if (out.empty())
+            return -1;
+        std::vector<cv::Mat> channels;
+        cv::split(out, channels);
+        double peak = 0;
+        cv::minMaxLoc(channels[1], nullptr, &peak);
+        const cv::Mat lit = channels[1] > 0.25 * peak;
+        for (int y = 0; y < lit.rows; ++y)
+            if (const int n = cv::countNonZero(lit.row(y)); n > 0)
+                return n;
+        return 0;
+    };
+    const int corner = topRowWidth("0");
+    const int edge = topRowWidth("30");
+    EXPECT_GT(corner, 0);
+    EXPECT_LE(corner, 3);
+    EXPECT_GE(edge, 7) << "corner on top: " << corner << " px";
+}
+
+// Defect: --hexagon ignored or the kernels swapped. The rhombi keep a point's light (the sum of
+// the output equals the input's 1.0); McIntosh's chain takes the minimum of two blurs, which
+// loses light where the two disagree (README: three quarters of a highlight's energy).
+TEST_F(CliFlags, HexagonRhombiKeepALightsEnergyAndMcIntoshsMinimumDoesNot)
+{
+    const auto energy = [&](const std::string& kernel) {
+        const cv::Mat out =
+            render(fmt::format("'{}' --depth '{}' --coc-model focal-range --focus 1 --near 0.5 --far 2 --max-coc 21 --quality "
+                               "high --no-highlight-sprites --hexagon {}",
+                               file("point.exr").string(), file("far81.png").string(), kernel),
+                   ".exr");
+        return out.empty() ? -1.0 : cv::sum(out)[1];
+    };
+    const double rhombi = energy("rhombi");
+    const double mcintosh = energy("mcintosh");
+    EXPECT_NEAR(rhombi, 1.0, 0.03);
+    EXPECT_LT(mcintosh, 0.9 * rhombi) << "rhombi " << rhombi;
+    EXPECT_GT(mcintosh, 0.3 * rhombi) << "rhombi " << rhombi;
+}
+
+// --- quality -----------------------------------------------------------------------------------
+
+// Defects: --quality ignored, a preset with the wrong taps or size, explicit options not
+// overriding the preset (or the preset overriding them when it comes after them). fast =
+// balanced with 4 taps; high = balanced with 12 taps at full size; --hexagon and --near-field
+// override each preset (the plan --explain prints says what ran).
+TEST_F(CliFlags, QualityPresetsAndTheOptionsThatOverrideThem)
+{
+    const std::string lens = "--f-number 1.4 --focal-length 85 --max-coc 32 "; // lines longer than 6 taps
+    const cv::Mat balanced = texture("near_far.png", lens);
+    const cv::Mat fast = texture("near_far.png", lens + "--quality fast");
+    const cv::Mat high = texture("near_far.png", lens + "--quality high");
+    EXPECT_FALSE(identical(balanced, fast));
+    EXPECT_FALSE(identical(balanced, high));
+    EXPECT_TRUE(identical(fast, texture("near_far.png", lens + "--samples 4 --quality balanced")));
+    EXPECT_TRUE(identical(high, texture("near_far.png", lens + "--samples 12 --resolution full")));
+    EXPECT_TRUE(identical(texture("near_far.png", lens + "--quality high --resolution half"),
+                          texture("near_far.png", lens + "--samples 12")));
+
+    const auto plan = [&](const std::string& options) {
+        const Ran run = defocus(fmt::format("'{}' --depth '{}' --focus 1 {} --explain -q -y -o '{}' {}",
+                                            file("colour.png").string(), file("near_focus.png").string(), lens,
+                                            file("explain.png").string(), options));
+        EXPECT_EQ(run.exitCode, 0) << run.err;
+        return run.out;
+    };
+    const std::string fastPlan = plan("--quality fast");
+    EXPECT_NE(fastPlan.find("rhombi x2"), std::string::npos) << fastPlan;
+    EXPECT_NE(fastPlan.find("half size"), std::string::npos) << fastPlan;
+    EXPECT_NE(fastPlan.find("near field on"), std::string::npos) << fastPlan;
+    const std::string highPlan = plan("--quality high --hexagon mcintosh");
+    EXPECT_NE(highPlan.find("mcintosh x3"), std::string::npos) << highPlan;
+    EXPECT_EQ(highPlan.find("half size"), std::string::npos) << highPlan;
+    const std::string balancedPlan = plan("--no-near-field --quality balanced");
+    EXPECT_NE(balancedPlan.find("near field off"), std::string::npos) << balancedPlan;
+}
+
+// Defect: --samples ignored: 2 taps per line and 12 give different pictures, and 2 taps leave
+// the kernel's gaps (a rougher, less blurred-looking result) that 12 fill.
+TEST_F(CliFlags, SamplesSetTheTapsPerLine)
+{
+    const cv::Mat two = texture("far.png", "--f-number 1.4 --focal-length 85 --max-coc 16 --samples 2");
+    const cv::Mat twelve = texture("far.png", "--f-number 1.4 --focal-length 85 --max-coc 16 --samples 12");
+    EXPECT_GT(difference(two, twelve), 0.2);
+}
+
+// Defect: --precision ignored. The linear output of 16F targets differs from that of 32F ones,
+// and the preset's 32F is what runs without the option.
+TEST_F(CliFlags, PrecisionSetsTheTargetFormat)
+{
+    const std::string lens = "--f-number 1.4 --max-coc 16";
+    const cv::Mat preset = texture("near_far.png", lens, ".exr");
+    const cv::Mat f32 = texture("near_far.png", lens + " --precision 32f", ".exr");
+    const cv::Mat f16 = texture("near_far.png", lens + " --precision 16f", ".exr");
+    EXPECT_TRUE(identical(preset, f32));
+    ASSERT_FALSE(f16.empty());
+    EXPECT_GT(cv::norm(f16, f32, cv::NORM_INF), 0.0);
+}
+
+// Defects: --resolution ignored, half size changing the frame's size (161x121 is odd), or losing
+// the in-focus pixels it promises to keep: the plane at the focus stays the input's, to the bit.
+TEST_F(CliFlags, ResolutionHalfKeepsTheSizeAndTheInFocusPixels)
+{
+    const cv::Mat in = input();
+    const cv::Mat half = texture("focus_far.png", "--f-number 1.4 --max-coc 16 --resolution half");
+    const cv::Mat full = texture("focus_far.png", "--f-number 1.4 --max-coc 16 --resolution full");
+    ASSERT_EQ(half.size(), in.size());
+    EXPECT_EQ(difference(half, in, kLeft), 0.0);
+    EXPECT_GT(difference(half, in, kRight), 1.0);
+    EXPECT_FALSE(identical(half, full));
+}
+
+// Defect: --near-field ignored. The blurred foreground (0.6 m) spreads over the plane at the focus
+// behind it with the near field, and does not without it: there the in-focus pixels next to
+// the edge stay the input's.
+TEST_F(CliFlags, NearFieldSpreadsTheForegroundOverWhatIsBehind)
+{
+    const cv::Mat in = input();
+    const cv::Rect band(kSplit + 1, 0, 4, kHeight);
+    const std::string lens = "--f-number 1.4 --focal-length 85 --max-coc 16"; // 0.6 m: 16 px
+    EXPECT_GT(difference(texture("near_focus.png", lens + " --near-field"), in, band), 1.0);
+    EXPECT_EQ(difference(texture("near_focus.png", lens + " --no-near-field"), in, band), 0.0);
+}
+
+// Defect: --highlight-sprites / --no-highlight-sprites ignored. A light 30 times white is
+// scattered as a sprite by default, and only gathered without them; --explain says which.
+TEST_F(CliFlags, HighlightSpritesScatterLightsAboveWhite)
+{
+    const auto run = [&](const std::string& option) {
+        const fs::path out = file("sprites" + std::to_string(option.size()) + ".exr");
+        const Ran r = defocus(fmt::format("'{}' --depth '{}' --coc-model focal-range --focus 1 --near 0.5 --far 2 --max-coc 21 "
+                                          "--explain -q -o '{}' {}",
+                                          file("light.exr").string(), file("far81.png").string(), out.string(), option));
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return std::make_pair(r.out, cv::imread(out.string(), cv::IMREAD_UNCHANGED));
+    };
+    const auto [onByDefault, spritesOn] = run("");
+    const auto [off, spritesOff] = run("--no-highlight-sprites");
+    EXPECT_NE(onByDefault.find("(bokeh sprites)"), std::string::npos) << onByDefault;
+    EXPECT_EQ(off.find("(bokeh sprites)"), std::string::npos) << off;
+    EXPECT_NE(off.find("highlights"), std::string::npos) << off;
+    ASSERT_FALSE(spritesOn.empty());
+    EXPECT_GT(cv::norm(spritesOn, spritesOff, cv::NORM_INF), 0.1);
+    EXPECT_TRUE(identical(spritesOn, run("--highlight-sprites").second));
+}
+
+// Defect: --highlight-gain ignored. A clipped light in 8-bit input blooms: with the gain its
+// blurred hexagon holds more light than without, and --explain reports the recovery.
+TEST_F(CliFlags, HighlightGainMakesClippedLightsBloom)
+{
+    const auto run = [&](const std::string& gain) {
+        const fs::path out = file("gain" + gain + ".exr");
+        const Ran r = defocus(fmt::format("'{}' --depth '{}' --coc-model focal-range --focus 1 --near 0.5 --far 2 --max-coc 21 "
+                                          "--explain -q -o '{}' --highlight-gain {}",
+                                          file("clipped.png").string(), file("far81.png").string(), out.string(), gain));
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return std::make_pair(r.out, cv::imread(out.string(), cv::IMREAD_UNCHANGED));
+    };
+    const auto [plain, off] = run("1");
+    const auto [explained, on] = run("8");
+    ASSERT_FALSE(on.empty());
+    ASSERT_FALSE(off.empty());
+    // The light above the grey around it, in the 31x31 pixels about the light.
+    const auto excess = [](const cv::Mat& out) {
+        const cv::Rect centre(25, 25, 31, 31);
+        return cv::sum(out(centre))[1] - cv::mean(out(cv::Rect(0, 0, 10, 10)))[1] * centre.area();
+    };
+    EXPECT_GT(excess(on), 3.0 * excess(off)) << "without the gain " << excess(off);
+    EXPECT_NE(explained.find("recovered x8"), std::string::npos) << explained;
+    EXPECT_EQ(plain.find("recovered"), std::string::npos) << plain;
+}
+
+// --- what is written ---------------------------------------------------------------------------
+
+// Defects: --view writing the wrong stage, or every view the same picture. input is the frame
+// itself (the sRGB round trip is exact at 8 bits); the four blur stages differ from each other
+// and from it; depth and coc draw the two planes apart, coc the near plane blue and the far red.
+TEST_F(CliFlags, ViewWritesEachStage)
+{
+    const cv::Mat in = input();
+    std::map<std::string, cv::Mat> views;
+    for (const char* view : {"input", "horizontal", "diagonal-a", "diagonal-b", "composite", "depth", "coc"})
+        views[view] = texture("near_far.png", std::string("--f-number 1.4 --max-coc 16 --quality high --view ") + view);
+    EXPECT_LE(difference(views["input"], in), 0.01);
+    const std::vector<std::string> stages{"horizontal", "diagonal-a", "diagonal-b", "composite"};
+    for (std::size_t i = 0; i < stages.size(); ++i) {
+        EXPECT_GT(difference(views[stages[i]], in), 0.5) << stages[i];
+        for (std::size_t j = i + 1; j < stages.size(); ++j)
+            EXPECT_FALSE(identical(views[stages[i]], views[stages[j]])) << stages[i] << " = " << stages[j];
+    }
+    const cv::Scalar nearCoc = cv::mean(views["coc"](cv::Rect(10, 10, 40, 60)));
+    const cv::Scalar farCoc = cv::mean(views["coc"](cv::Rect(kWidth - 50, 10, 40, 60)));
+    EXPECT_GT(nearCoc[0], nearCoc[2] + 20) << "near: BGR " << nearCoc;
+    EXPECT_GT(farCoc[2], farCoc[0] + 20) << "far: BGR " << farCoc;
+    const cv::Scalar nearDepth = cv::mean(views["depth"](cv::Rect(10, 10, 40, 60)));
+    const cv::Scalar farDepth = cv::mean(views["depth"](cv::Rect(kWidth - 50, 10, 40, 60)));
+    EXPECT_GT(cv::norm(nearDepth - farDepth), 30.0);
+}
+
+// Defect: --fps ignored (the video takes the input's rate, 30 Hz for a folder of images).
+TEST_F(CliFlags, FpsSetsTheVideosRate)
+{
+    const auto rate = [&](const std::string& option) {
+        const fs::path out = file("rate" + std::to_string(option.size()) + ".avi");
+        const Ran r = defocus(fmt::format("'{}' --depth '{}' --focus 1 -q -o '{}' {}", file("clip/rgb").string(),
+                                          file("clip/depth").string(), out.string(), option));
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        cv::VideoCapture video(out.string());
+        EXPECT_EQ(video.get(cv::CAP_PROP_FRAME_COUNT), 2.0);
+        return video.get(cv::CAP_PROP_FPS);
+    };
+    EXPECT_NEAR(rate("--fps 12"), 12.0, 0.01);
+    EXPECT_NEAR(rate(""), 30.0, 0.01);
+}
+
+// Defect: --timings writing nothing, a frame missing, or GPU passes left out. Each frame has its
+// wall times, the summary counts every frame, and with timer queries each pass is there.
+TEST_F(CliFlags, TimingsWritesEveryFrameAndTheSummary)
+{
+    const fs::path json = file("timings.json");
+    const Ran r = defocus(fmt::format("'{}' --depth '{}' --focus 1 --f-number 1.4 -q -o '{}' --timings '{}'",
+                                      file("clip/rgb").string(), file("clip/depth").string(),
+                                      file("timed/").string(), json.string()));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    std::ifstream in(json);
+    ASSERT_TRUE(in) << json;
+    const nlohmann::json doc = nlohmann::json::parse(in);
+    EXPECT_EQ(doc["width"], kWidth);
+    EXPECT_EQ(doc["height"], kHeight);
+    ASSERT_EQ(doc["frames"].size(), 2u);
+    for (std::size_t i = 0; i < 2; ++i) {
+        EXPECT_EQ(doc["frames"][i]["index"], i);
+        EXPECT_GT(doc["frames"][i]["total_ms"].get<double>(), 0.0);
+    }
+    EXPECT_EQ(doc["summary"]["total_ms"]["frames"], 2);
+    if (defocus("--info").out.find("GPU timers:   yes") != std::string::npos)
+        for (const char* pass : {"coc", "rhombi-1", "rhombi-2", "upscale"}) {
+            EXPECT_EQ(doc["summary"]["gpu_ms"][pass]["frames"], 2) << pass;
+            for (std::size_t i = 0; i < 2; ++i)
+                EXPECT_TRUE(doc["frames"][i]["gpu_ms"].contains(pass)) << "frame " << i << ", " << pass;
+        }
+}
+
+// Defect: --explain silent, or printing when not asked: one line per frame on stdout, what the
+// plan ran (here the rhombi with the near field), and a frame all in focus said to be one.
+TEST_F(CliFlags, ExplainPrintsThePlanOfEachFrame)
+{
+    const std::string clip = fmt::format("'{}' --depth '{}' --focus 1 -q", file("clip/rgb").string(),
+                                         file("clip/depth").string());
+    const Ran blurred = defocus(clip + " --f-number 1.4 --explain -o '" + file("explained/").string() + "'");
+    ASSERT_EQ(blurred.exitCode, 0) << blurred.err;
+    EXPECT_NE(blurred.out.find("frame 0: coc, blur rhombi x2"), std::string::npos) << blurred.out;
+    EXPECT_NE(blurred.out.find("\nframe 1: coc, blur rhombi x2"), std::string::npos) << blurred.out;
+    EXPECT_NE(blurred.out.find("near field on"), std::string::npos) << blurred.out;
+    const Ran sharp = defocus(clip + " --max-coc 0.4 --explain -o '" + file("sharp/").string() + "'");
+    EXPECT_NE(sharp.out.find("frame 0: all in focus"), std::string::npos) << sharp.out;
+    const Ran quiet = defocus(clip + " --f-number 1.4 -o '" + file("unexplained/").string() + "'");
+    EXPECT_EQ(quiet.out.find("frame 0:"), std::string::npos) << quiet.out;
+}
+
+// Defect: --always-on ignored: a frame all in focus is passed through by the plan (no pass runs,
+// the summary has no GPU passes) and rendered by every pass with --always-on, to the same bits.
+TEST_F(CliFlags, AlwaysOnRunsEveryPassWithTheSameResult)
+{
+    const auto run = [&](const std::string& option) {
+        const fs::path out = file("always" + std::to_string(option.size()) + ".png");
+        const Ran r = defocus(fmt::format("'{}' --depth '{}' --focus 1 --max-coc 0.4 -o '{}' {}",
+                                          file("colour.png").string(), file("near_far.png").string(), out.string(),
+                                          option));
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return std::make_pair(r.out, cv::imread(out.string(), cv::IMREAD_UNCHANGED));
+    };
+    const auto [planned, passedThrough] = run("");
+    const auto [always, rendered] = run("--always-on");
+    EXPECT_NE(planned.find("GPU per pass: n/a"), std::string::npos) << planned;
+    if (defocus("--info").out.find("GPU timers:   yes") != std::string::npos) {
+        EXPECT_NE(always.find("GPU per pass: coc"), std::string::npos) << always;
+    }
+    EXPECT_TRUE(identical(passedThrough, rendered));
+    EXPECT_TRUE(identical(passedThrough, input()));
+}
+
+// Defect: --contact-sheet not written, or --contact-frame ignored; a frame index beyond the clip
+// silently writes nothing: it must warn on stderr, naming the option.
+TEST_F(CliFlags, ContactSheetOfTheChosenFrameAndAWarningBeyondTheClip)
+{
+    const std::string clip = fmt::format("'{}' --depth '{}' --focus 1 --f-number 1.4 -q", file("clip/rgb").string(),
+                                         file("clip/depth").string());
+    const fs::path sheet0 = file("sheet0.png"), sheet1 = file("sheet1.png");
+    EXPECT_EQ(defocus(clip + " -o '" + file("s0/").string() + "' --contact-sheet '" + sheet0.string() + "'").exitCode,
+              0);
+    const Ran second = defocus(clip + " -o '" + file("s1/").string() + "' --contact-sheet '" + sheet1.string() +
+                               "' --contact-frame 1");
+    EXPECT_EQ(second.exitCode, 0) << second.err;
+    const cv::Mat a = cv::imread(sheet0.string()), b = cv::imread(sheet1.string());
+    ASSERT_FALSE(a.empty());
+    ASSERT_FALSE(b.empty());
+    EXPECT_GT(a.cols * a.rows, 8 * kWidth * kHeight); // every view and the plan, labelled
+    EXPECT_FALSE(identical(a, b));                     // frame 1 is frame 0 mirrored
+    EXPECT_EQ((second.err + second.out).find("warning"), std::string::npos) << second.err;
+
+    const fs::path beyond = file("sheet5.png");
+    const Ran r = defocus(clip + " -o '" + file("s5/").string() + "' --contact-sheet '" + beyond.string() +
+                          "' --contact-frame 5");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE((r.err + r.out).find("warning: --contact-frame 5 is beyond"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(beyond));
+}
+
+// Defect: --focus-point ignored (the centre measured): at a pixel of the near plane the automatic
+// focus is 0.6 m, at one of the far plane 3 m (--explain prints each frame's focus).
+TEST_F(CliFlags, FocusPointMeasuresTheFocusThere)
+{
+    const auto focus = [&](const std::string& point) {
+        const Ran r = defocus(fmt::format("'{}' --depth '{}' --focus auto --focus-point {} --explain -q -o '{}'",
+                                          file("colour.png").string(), file("near_far.png").string(), point,
+                                          file("point" + std::to_string(point.size()) + point.substr(0, 2) + ".png").string()));
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return r.out;
+    };
+    EXPECT_NE(focus("20,60").find("frame 0: focus 0.6000 m"), std::string::npos) << focus("20,60");
+    EXPECT_NE(focus("140,60").find("frame 0: focus 3.0000 m"), std::string::npos) << focus("140,60");
+}
+
+// Defect: --tau ignored: tracking focus jumps with the depth (1 m, then 3 m) at once with --tau
+// 0, and moves only a little of the way in one frame (1/30 s) with a time constant of 10 s.
+TEST_F(CliFlags, TauDampsTheTrackedFocus)
+{
+    const auto explain = [&](const std::string& tau) {
+        const Ran r = defocus(fmt::format("'{}' --depth '{}' --focus track --tau {} --explain -q -o '{}'",
+                                          file("jump/rgb").string(), file("jump/depth").string(), tau,
+                                          file("tau" + tau + "/").string()));
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return r.out;
+    };
+    const std::string at0 = explain("0"), at10 = explain("10");
+    EXPECT_NE(at0.find("frame 1: focus 3.0000 m"), std::string::npos) << at0;
+    EXPECT_EQ(at10.find("frame 1: focus 3.0000 m"), std::string::npos) << at10;
+    EXPECT_NE(at10.find("frame 1: focus 1.0"), std::string::npos) << at10;
+}
+
+// Defects: --codec ignored (the container's default written), --image-format ignored.
+TEST_F(CliFlags, CodecAndImageFormatChooseWhatIsWritten)
+{
+    const std::string clip = fmt::format("'{}' --depth '{}' --focus 1 -q", file("clip/rgb").string(),
+                                         file("clip/depth").string());
+    const auto fourcc = [&](const std::string& name, const std::string& option) {
+        const fs::path out = file(name);
+        const Ran r = defocus(clip + " -o '" + out.string() + "' " + option);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        cv::VideoCapture video(out.string());
+        const auto code = static_cast<unsigned>(video.get(cv::CAP_PROP_FOURCC));
+        return std::string{static_cast<char>(code & 0xff), static_cast<char>(code >> 8 & 0xff),
+                           static_cast<char>(code >> 16 & 0xff), static_cast<char>(code >> 24 & 0xff)};
+    };
+    EXPECT_EQ(fourcc("default.mkv", ""), "FFV1");
+    const std::string mjpg = fourcc("mjpg.mkv", "--codec mjpg"); // Matroska tags it "mjpe" or "MJPG"
+    EXPECT_TRUE(mjpg == "MJPG" || mjpg == "mjpe") << mjpg;
+
+    const auto written = [&](const std::string& name, const std::string& option) {
+        const fs::path out = file(name);
+        const Ran r = defocus(clip + " -o '" + out.string() + "/' " + option);
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        std::set<std::string> extensions;
+        // The frames: the files at the top of the folder but the TUM lists (depth/ has its own).
+        for (const auto& e : fs::directory_iterator(out))
+            if (e.is_regular_file() && e.path().extension() != ".txt")
+                extensions.insert(e.path().extension().string());
+        return extensions;
+    };
+    EXPECT_EQ(written("png_frames", ""), std::set<std::string>{".png"});
+    EXPECT_EQ(written("exr_frames", "--image-format exr"), std::set<std::string>{".exr"});
+}
+
+// --- the program itself ------------------------------------------------------------------------
+
+// Defect: --info needing an input, or printing nothing useful.
+TEST_F(CliFlags, InfoPrintsThePlatformAndExits)
+{
+    const Ran r = defocus("--info");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    for (const char* line : {"EGL platform: ", "GL vendor:    ", "GL renderer:  ", "GL version:   4.", "GPU timers:   "})
+        EXPECT_NE(r.out.find(line), std::string::npos) << line << " in\n" << r.out;
+}
+
+// Defects: -q printing the log, -v not adding the debug lines, --version not the version.
+TEST_F(CliFlags, QuietVerboseAndVersion)
+{
+    const std::string args = fmt::format("'{}' --depth '{}' --focus 1 -y -o '{}'", file("colour.png").string(),
+                                         file("far.png").string(), file("logged.png").string());
+    const Ran plain = defocus(args), quiet = defocus(args + " -q"), verbose = defocus(args + " -v");
+    EXPECT_NE((plain.err + plain.out).find("info:"), std::string::npos) << plain.err;
+    EXPECT_EQ((quiet.err + quiet.out).find("info:"), std::string::npos) << quiet.err;
+    EXPECT_NE(quiet.out.find("1 frames in, 1 frames out"), std::string::npos) << quiet.out;
+    EXPECT_NE((verbose.err + verbose.out).find("debug:"), std::string::npos) << verbose.err;
+    const Ran version = defocus("--version");
+    EXPECT_EQ(version.exitCode, 0);
+    EXPECT_NE(version.out.find("defocus 0."), std::string::npos) << version.out;
+}
+
+// Defect: an option added to the command line with no test through the binary. Every option
+// --help lists is named here with the test that runs it; one missing from --help fails too.
+TEST_F(CliFlags, EveryOptionInTheHelpHasATest)
+{
+    const std::map<std::string, std::string> tested{
+        {"--help", "this test"},
+        {"--version", "CliFlags.QuietVerboseAndVersion"},
+        {"--output", "every test here (-o)"},
+        {"--depth", "every test here; BadInputGLTest"},
+        {"--depth-scale", "CliGLTest, LibraryGLTest.CommandLineAndLibraryGiveTheSamePicture"},
+        {"--focus", "every test here; LibraryGLTest (auto)"},
+        {"--f-number", "CliFlags.CocModelFocalRangeIgnoresTheAperture; SyntheticSceneGLTest"},
+        {"--focal-length", "CliFlags.FocalLengthLongerLensBlursMore"},
+        {"--sensor-width", "CliFlags.SensorWidthSmallerSensorBlursMore"},
+        {"--fov-from", "CliFlags.FovFromImageDistanceBlursMoreUnlessFocusedAtInfinity"},
+        {"--max-coc", "CliFlags.MaxCocClampsTheBlur"},
+        {"--coc-model", "CliFlags.CocModelFocalRangeIgnoresTheAperture"},
+        {"--near", "CliFlags.NearMovesOnlyTheNearBlur"},
+        {"--far", "CliFlags.FarMovesOnlyTheFarBlur"},
+        {"--quality", "CliFlags.QualityPresetsAndTheOptionsThatOverrideThem"},
+        {"--samples", "CliFlags.SamplesSetTheTapsPerLine"},
+        {"--hexagon", "CliFlags.HexagonRhombiKeepALightsEnergyAndMcIntoshsMinimumDoesNot"},
+        {"--blade-rotation", "CliFlags.BladeRotationPutsACornerOrAnEdgeOnTop"},
+        {"--precision", "CliFlags.PrecisionSetsTheTargetFormat"},
+        {"--resolution", "CliFlags.ResolutionHalfKeepsTheSizeAndTheInFocusPixels"},
+        {"--view", "CliFlags.ViewWritesEachStage"},
+        {"--contact-sheet", "CliFlags.ContactSheetOfTheChosenFrameAndAWarningBeyondTheClip"},
+        {"--contact-frame", "CliFlags.ContactSheetOfTheChosenFrameAndAWarningBeyondTheClip"},
+        {"--frames", "SyntheticSceneGLTest (--demo --frames 3)"},
+        {"--start", "CliGLTest StartEveryAndKeyedFocusPerFrame"},
+        {"--every", "CliGLTest StartEveryAndKeyedFocusPerFrame"},
+        {"--focus-point", "CliFlags.FocusPointMeasuresTheFocusThere"},
+        {"--tau", "CliFlags.TauDampsTheTrackedFocus"},
+        {"--overwrite", "exit-status-test.sh (existing output with and without -y)"},
+        {"--codec", "CliFlags.CodecAndImageFormatChooseWhatIsWritten"},
+        {"--image-format", "CliFlags.CodecAndImageFormatChooseWhatIsWritten"},
+        {"--fps", "CliFlags.FpsSetsTheVideosRate"},
+        {"--timings", "CliFlags.TimingsWritesEveryFrameAndTheSummary"},
+        {"--explain", "CliFlags.ExplainPrintsThePlanOfEachFrame"},
+        {"--highlight-gain", "CliFlags.HighlightGainMakesClippedLightsBloom"},
+        {"--near-field", "CliFlags.NearFieldSpreadsTheForegroundOverWhatIsBehind"},
+        {"--no-near-field", "CliFlags.NearFieldSpreadsTheForegroundOverWhatIsBehind"},
+        {"--highlight-sprites", "CliFlags.HighlightSpritesScatterLightsAboveWhite"},
+        {"--no-highlight-sprites", "CliFlags.HighlightSpritesScatterLightsAboveWhite"},
+        {"--always-on", "CliFlags.AlwaysOnRunsEveryPassWithTheSameResult"},
+        {"--info", "CliFlags.InfoPrintsThePlatformAndExits"},
+        {"--demo", "SyntheticSceneGLTest (the demo's frames are blurred)"},
+        {"--demo-scene", "SyntheticSceneGLTest (--demo-scene edges)"},
+        {"--quiet", "CliFlags.QuietVerboseAndVersion"},
+        {"--verbose", "CliFlags.QuietVerboseAndVersion"},
+    };
+    const Ran help = defocus("--help");
+    ASSERT_EQ(help.exitCode, 0);
+    std::set<std::string> listed;
+    const std::regex option(R"((^|[ ,])(--[a-z][a-z0-9-]*))");
+    std::istringstream lines(help.out);
+    for (std::string line; std::getline(lines, line);) {
+        // Option names start the line; later --names are in the description.
+        const auto text = line.find_first_not_of(' ');
+        if (text == std::string::npos || line[text] != '-')
+            continue;
+        const std::string names = line.substr(text, line.find(' ', text) - text);
+        for (auto it = std::sregex_iterator(names.begin(), names.end(), option); it != std::sregex_iterator(); ++it)
+            listed.insert((*it)[2]);
+    }
+    EXPECT_GT(listed.size(), 30u) << help.out;
+    for (const auto& name : listed)
+        EXPECT_TRUE(tested.count(name)) << name << " is in --help but has no test through the binary";
+    for (const auto& [name, where] : tested)
+        EXPECT_TRUE(listed.count(name)) << name << " (" << where << ") is no longer in --help";
+}
+
+} // namespace
+} // namespace defocus
