@@ -28,6 +28,7 @@
 #include "filter/Views.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
+#include "samples/Batch.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
 #include "samples/FocusSchedule.hpp"
@@ -79,16 +80,34 @@ struct Options {
     std::string codec;        ///< --codec, "" = the container's default
     std::string imageFormat = "png"; ///< --image-format of a folder output
     bool alwaysOn = false;
+    // Many clips (samples/Batch.hpp) and the GPU.
+    std::string batch;         ///< --batch MANIFEST
+    std::string shard;         ///< --shard I/N, "" = the Slurm array task's, else 0/1
+    bool redo = false;
+    std::string reportDir;
+    std::size_t inFlight = 1;
+    std::optional<int> eglDevice;
+    std::string report;        ///< --report FILE.json of a single run
 };
 
-int printInfo()
+gl::ContextOptions contextOptions(const Options& options)
 {
-    const auto context = gl::EglContext::create();
+    gl::ContextOptions context;
+    context.device = options.eglDevice;
+    return context;
+}
+
+int printInfo(const Options& options)
+{
+    for (const auto& d : gl::EglContext::devices())
+        fmt::print("EGL device {}: {}{}{}\n", d.index, d.software ? "software" : "hardware",
+                   d.drmFile.empty() ? "" : ", " + d.drmFile, d.cudaId ? fmt::format(", CUDA device {}", *d.cudaId) : "");
+    const auto context = gl::EglContext::create(contextOptions(options));
     const auto& info = context.info();
-    fmt::print("EGL platform: {}\nEGL vendor:   {}\nEGL version:  {}\nGL vendor:    {}\nGL renderer:  {}\n"
+    fmt::print("EGL platform: {}{}\nEGL vendor:   {}\nEGL version:  {}\nGL vendor:    {}\nGL renderer:  {}\n"
                "GL version:   {}\nGPU timers:   {}\n",
-               info.platform, info.eglVendor, info.eglVersion, info.glVendor, info.glRenderer, info.glVersion,
-               info.timerQueries ? "yes" : "no");
+               info.platform, info.device >= 0 ? fmt::format(" (EGL device {})", info.device) : "", info.eglVendor,
+               info.eglVersion, info.glVendor, info.glRenderer, info.glVersion, info.timerQueries ? "yes" : "no");
     return kExitDone;
 }
 
@@ -136,9 +155,10 @@ public:
                 for (const auto& pass : passes)
                     f["gpu_ms"][pass.name] = pass.ms;
     }
-    void write(const std::string& file, const std::string& renderer, cv::Size size) const
+    /// p50/p95/max of each timing and each pass over the frames so far.
+    nlohmann::json summary() const
     {
-        nlohmann::json summary;
+        nlohmann::json summary = nlohmann::json::object();
         const auto stats = [](std::vector<double> v) {
             std::sort(v.begin(), v.end());
             const auto at = [&](double q) { return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)]; };
@@ -157,10 +177,14 @@ public:
                 passes[name].push_back(ms.get<double>());
         for (const auto& [name, v] : passes)
             summary["gpu_ms"][name] = stats(v);
+        return summary;
+    }
+    void write(const std::string& file, const std::string& renderer, cv::Size size) const
+    {
         const nlohmann::json doc{{"renderer", renderer},
                                  {"width", size.width},
                                  {"height", size.height},
-                                 {"summary", summary},
+                                 {"summary", summary()},
                                  {"frames", frames_}};
         writeFileAtomically(file, doc.dump(2) + "\n");
     }
@@ -187,10 +211,47 @@ struct GlSession {
     Pipeline pipeline;
 };
 
+/// What a clip's report says of it (--report, --batch): frames, the settings as resolved, the
+/// renderer, and the timings' p50/p95/max.
+void fillReport(nlohmann::json& r, const Options& options, const LensSettings& lens, const gl::ContextInfo& info,
+                std::size_t framesIn, const FrameSink& sink, const TimingLog& timingLog)
+{
+    r["frames_in"] = framesIn;
+    r["frames_out"] = sink.framesWritten();
+    r["output"] = sink.describe();
+    r["renderer"] = {{"platform", info.platform},     {"egl_device", info.device}, {"egl_vendor", info.eglVendor},
+                     {"egl_version", info.eglVersion}, {"gl_vendor", info.glVendor}, {"gl_renderer", info.glRenderer},
+                     {"gl_version", info.glVersion}};
+    r["settings"] = {{"focus", options.focus},
+                     {"focus_m", lens.focusM},
+                     {"f_number", lens.fNumber},
+                     {"focal_length_mm", lens.focalLengthMm},
+                     {"sensor_width_mm", lens.sensorWidthMm},
+                     {"fov_from", fieldOfViewName(lens.fieldOfView)},
+                     {"max_coc_px", lens.maxCocPx},
+                     {"coc_model", options.model},
+                     {"near_m", lens.nearLimitM},
+                     {"far_m", lens.farLimitM},
+                     {"blade_rotation_deg", lens.bladeRotationDeg},
+                     {"quality", options.qualityPreset},
+                     {"samples", options.quality.samples},
+                     {"hexagon", options.kernel},
+                     {"precision", options.precision},
+                     {"resolution", options.resolution},
+                     {"near_field", options.quality.nearField},
+                     {"highlight_sprites", options.quality.highlightSprites},
+                     {"highlight_gain", options.quality.highlightGain},
+                     {"adaptive", options.quality.adaptive},
+                     {"view", options.view},
+                     {"frames", options.frames ? nlohmann::json(*options.frames) : nlohmann::json()}};
+    r["timings_ms"] = timingLog.summary();
+}
+
 /// The frames of one clip from `source` through the pipeline into `sink`; returns the exit status.
 /// Stops early at SIGINT/SIGTERM (the sink is finalised all the same) or at an error (the frames
 /// before it are kept).
-int processClip(const Options& options, FrameSource& source, SyntheticSource* demo, FrameSink& sink, GlSession& gl)
+int processClip(const Options& options, FrameSource& source, SyntheticSource* demo, FrameSink& sink, GlSession& gl,
+                nlohmann::json* report)
 {
     View view = View::Composite;
     parseView(options.view, view); // validated by CLI11's check
@@ -291,6 +352,8 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         progress.finish();
         spdlog::error("frame {}: {}", current, error.what());
         status = cli::statusFor(error);
+        if (report)
+            (*report)["error"] = fmt::format("frame {}: {}", current, error.what());
     }
     try {
         sink.finish();
@@ -314,8 +377,12 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
                      framesIn, options.output);
         status = cli::stopStatus();
     }
+    if (report)
+        fillReport(*report, options, lens, gl.context.info(), framesIn, sink, timingLog);
     if (status == kExitDone && framesIn == 0) {
         spdlog::error("{} gave no frames", options.input);
+        if (report)
+            (*report)["error"] = fmt::format("{} gave no frames", options.input);
         return kExitBadInput;
     }
     std::fflush(stdout);
@@ -328,7 +395,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
 /// One clip, from INPUT (or --demo) to -o OUTPUT: opens the input, the GL session when `gl` holds
 /// none yet (so a bad input is reported before GL is needed), the output, and runs processClip.
 /// Throws for an input, output or GL that cannot be opened (cli::statusFor gives the status).
-int runClip(Options options, std::optional<GlSession>& gl)
+int runClip(Options options, std::optional<GlSession>& gl, nlohmann::json* report = nullptr)
 {
     // Outputs besides the main one are checked before any frame is processed.
     if (!options.contactSheet.empty())
@@ -341,7 +408,7 @@ int runClip(Options options, std::optional<GlSession>& gl)
     if (options.demo) {
         // --demo renders its frames with GL, so the context comes first (the filter shares it).
         if (!gl)
-            gl.emplace(gl::EglContext::create());
+            gl.emplace(gl::EglContext::create(contextOptions(options)));
         auto synthetic = openDemo(options);
         demo = synthetic.get();
         source = std::move(synthetic);
@@ -354,7 +421,7 @@ int runClip(Options options, std::optional<GlSession>& gl)
     }
 
     if (!gl)
-        gl.emplace(gl::EglContext::create());
+        gl.emplace(gl::EglContext::create(contextOptions(options)));
 
     SinkOptions sinkOptions;
     sinkOptions.output = options.output;
@@ -372,7 +439,7 @@ int runClip(Options options, std::optional<GlSession>& gl)
     }
     if (!options.quiet)
         spdlog::info("{} -> {} on {}", source->describe(), options.output, gl->context.info().glRenderer);
-    const int status = processClip(options, *source, demo, *sink, *gl);
+    const int status = processClip(options, *source, demo, *sink, *gl, report);
     if (newest && !options.quiet)
         spdlog::info("live: {} frames captured, {} dropped (the filter was slower than the camera)",
                      newest->captured(), newest->dropped());
@@ -382,6 +449,9 @@ int runClip(Options options, std::optional<GlSession>& gl)
 /// The command line, bound to `o`.
 void declareOptions(CLI::App& app, Options& o)
 {
+    // Given twice, an option's last value counts: a manifest line's options come after the
+    // command line's and win (--batch).
+    app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     app.set_version_flag("--version", "defocus 0.1.0");
     app.add_option("input", o.input, "Colour input: TUM folder, image folder or image file");
     app.add_option("-o,--output", o.output,
@@ -485,6 +555,23 @@ void declareOptions(CLI::App& app, Options& o)
                    "Frames of a folder output: png (8-bit sRGB) or exr (linear float, HDR kept)")
         ->check(CLI::IsMember({"png", "exr"}))
         ->capture_default_str();
+    app.add_option("--egl-device", o.eglDevice,
+                   "EGL device to render on, only that one (--info lists them) [default: the GPU that "
+                   "CUDA_VISIBLE_DEVICES makes CUDA's first, else the first that works, else Mesa surfaceless]")
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--report", o.report,
+                   "When the clip is done (or failed on its input), write a JSON report: frames, settings, timings, "
+                   "renderer, version, commit, exit status");
+    app.add_option("--batch", o.batch,
+                   "Many clips, one process: MANIFEST has one clip a line, INPUT<TAB>DEPTH<TAB>OUTPUT[<TAB>options] "
+                   "or JSON; each done clip gets OUTPUT.report.json and is skipped by a rerun (README, Many clips)");
+    app.add_option("--shard", o.shard,
+                   "--batch: only clips k with k % N == I, as I/N [default: the Slurm array task's, else 0/1]");
+    app.add_flag("--redo", o.redo, "--batch: do clips that have a report again");
+    app.add_option("--report-dir", o.reportDir, "--batch: put the reports here [default: beside each output]");
+    app.add_option("--in-flight", o.inFlight, "--batch: clips processed at once, a GL context each, 1..16")
+        ->check(CLI::Range(1, 16))
+        ->capture_default_str();
 }
 
 /// After parsing: presets under the explicit options, names to enums, ranges. nullopt: go on;
@@ -539,6 +626,111 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
     return std::nullopt;
 }
 
+/// One clip with --report: the report is written after the clip, when it is done or failed on
+/// its input; a stopped clip or a GL failure leaves none (as --batch does).
+int runReported(const Options& options, std::optional<GlSession>& gl)
+{
+    nlohmann::json report = nlohmann::json::object();
+    int status = kExitDone;
+    try {
+        status = runClip(options, gl, &report);
+    } catch (const std::exception& error) {
+        spdlog::error("{}", error.what());
+        status = cli::statusFor(error);
+        report["error"] = error.what();
+    }
+    if (status != kExitDone && status != kExitBadInput)
+        return status;
+    report["status"] = status == kExitDone ? "done" : "failed";
+    report["exit_status"] = status;
+    report["input"] = options.input;
+    report["build"] = batch::buildInfo();
+    batch::writeReport(options.report, report);
+    return status;
+}
+
+/// --batch MANIFEST: this process's shard of the manifest's clips, each parsed as the command line
+/// `arguments` followed by the clip's options, input, output and depth. Every clip's options are
+/// checked before the first clip runs.
+int runBatchCommand(const Options& global, const std::vector<std::string>& arguments)
+{
+    std::vector<batch::Clip> all;
+    batch::Shard shard;
+    try {
+        all = batch::readManifest(global.batch);
+        if (!global.shard.empty()) {
+            const auto parsed = batch::parseShard(global.shard);
+            if (!parsed) {
+                spdlog::error("--shard '{}' is not I/N with 0 <= I < N", global.shard);
+                return kExitUsage;
+            }
+            shard = *parsed;
+        } else if (const auto slurm = batch::shardFromSlurm([](const char* name) { return std::getenv(name); })) {
+            shard = *slurm;
+        }
+        batch::checkReportPaths(all, global.reportDir);
+    } catch (const batch::ManifestError& error) {
+        spdlog::error("{}", error.what());
+        return kExitUsage;
+    }
+    const auto clipOptions = [&](const batch::Clip& clip, Options& o) -> std::optional<int> {
+        std::vector<std::string> args = arguments;
+        args.insert(args.end(), clip.options.begin(), clip.options.end());
+        args.push_back(clip.input.string());
+        args.push_back("--output=" + clip.output.string());
+        if (!clip.depth.empty())
+            args.push_back("--depth=" + clip.depth.string());
+        CLI::App app;
+        declareOptions(app, o);
+        std::reverse(args.begin(), args.end()); // CLI11 takes a vector last argument first
+        try {
+            app.parse(args);
+        } catch (const CLI::ParseError& error) {
+            spdlog::error("{}:{}: {}", global.batch, clip.line, error.what());
+            return kExitUsage;
+        }
+        o.quiet = true;     // per-clip result lines only; no progress bars
+        o.overwrite = true; // a clip without a report is the batch's to (re)write
+        if (const auto status = finishOptions(app, o)) {
+            spdlog::error("{}:{}: the clip's options are not valid (above)", global.batch, clip.line);
+            return status;
+        }
+        return std::nullopt;
+    };
+    for (const auto& clip : all) {
+        Options o;
+        if (const auto status = clipOptions(clip, o))
+            return *status;
+    }
+    batch::BatchOptions options;
+    options.reportDir = global.reportDir;
+    options.redo = global.redo;
+    options.inFlight = global.inFlight;
+    options.shard = shard;
+    return batch::runBatch(
+        batch::select(all, shard), options,
+        [&](std::size_t) -> batch::ClipRunner {
+            // One context and one shader build for all of this worker's clips.
+            auto gl = std::make_shared<std::optional<GlSession>>();
+            gl->emplace(gl::EglContext::create(contextOptions(global)));
+            return [gl, &clipOptions](const batch::Clip& clip) {
+                batch::ClipOutcome outcome;
+                Options o;
+                clipOptions(clip, o);
+                (*gl)->context.makeCurrent();
+                try {
+                    outcome.status = runClip(o, *gl, &outcome.report);
+                } catch (const std::exception& error) {
+                    spdlog::error("{}", error.what());
+                    outcome.status = cli::statusFor(error);
+                    outcome.report["error"] = error.what();
+                }
+                return outcome;
+            };
+        },
+        cli::stopStatus);
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -557,12 +749,16 @@ int main(int argc, char** argv)
 
     try {
         if (o.info)
-            return printInfo();
+            return printInfo(o);
+        if (!o.batch.empty()) {
+            cli::catchStopSignals();
+            return runBatchCommand(o, std::vector<std::string>(argv + 1, argv + argc));
+        }
         if (const auto status = finishOptions(app, o))
             return *status;
         cli::catchStopSignals();
         std::optional<GlSession> gl;
-        return runClip(o, gl);
+        return o.report.empty() ? runClip(o, gl) : runReported(o, gl);
     } catch (const std::exception& error) {
         spdlog::error("{}", error.what());
         return cli::statusFor(error);

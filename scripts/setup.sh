@@ -23,6 +23,7 @@ packages=(
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev   # the GStreamer element (gst/)
   gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good   # its tests: gst-launch-1.0, pngdec, imagefreeze
   gstreamer1.0-plugins-ugly gstreamer1.0-libav gstreamer1.0-x   # README pipelines: x264enc, H.264 decoding, ximagesink
+  slurm-wlm munge parallel # many clips: the one-node Slurm test (slurmctld, slurmd, sbatch) and the GNU parallel test
 )
 
 missing=()

@@ -1,5 +1,8 @@
 // Several EGL contexts in one process: each lives and ends on its own.
+#include <optional>
+
 #include <epoxy/gl.h>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "filter/Pipeline.hpp"
@@ -38,6 +41,37 @@ TEST_F(EglContexts, EndingOneKeepsTheCurrentOneCurrent)
     context()->makeCurrent();
     other.reset();
     EXPECT_TRUE(context()->isCurrent());
+}
+
+// Defect: --egl-device N ignored (the context made on whatever device comes first), or a device
+// that does not exist answered with another device instead of an error naming the devices.
+TEST_F(EglContexts, AnAskedForDeviceIsUsedOrRefused)
+{
+    const auto devices = gl::EglContext::devices();
+    gl::ContextOptions options;
+    options.device = static_cast<int>(devices.size());
+    try {
+        gl::EglContext::create(options);
+        ADD_FAILURE() << "EGL device " << devices.size() << " of " << devices.size() << " gave a context";
+    } catch (const gl::ContextError& error) {
+        EXPECT_NE(std::string(error.what()).find(fmt::format("there is no EGL device {}", devices.size())),
+                  std::string::npos)
+            << error.what();
+    }
+    if (devices.empty())
+        GTEST_SKIP() << "this EGL lists no devices";
+    const int last = static_cast<int>(devices.size()) - 1;
+    options.device = last;
+    std::optional<gl::EglContext> other;
+    try {
+        other.emplace(gl::EglContext::create(options));
+    } catch (const gl::ContextError& error) {
+        GTEST_SKIP() << "EGL device " << last << " gives no GL 4.5 context here: " << error.what();
+    }
+    EXPECT_EQ(other->info().device, last);
+    EXPECT_EQ(other->info().platform.rfind("device", 0), 0u) << other->info().platform;
+    other.reset();
+    context()->makeCurrent();
 }
 
 } // namespace

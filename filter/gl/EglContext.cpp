@@ -1,6 +1,9 @@
-// EGL device platform first, Mesa surfaceless next; OpenGL 4.5 core; no surface at all.
+// EGL device platform first (the device asked for, or CUDA's, or each in turn), Mesa surfaceless
+// next; OpenGL 4.5 core; no surface at all.
 #include "filter/gl/EglContext.hpp"
 
+#include <algorithm>
+#include <cstdlib>
 #include <map>
 #include <mutex>
 #include <utility>
@@ -146,36 +149,139 @@ std::string glString(GLenum name)
 
 } // namespace
 
+namespace {
+
+#ifndef EGL_CUDA_DEVICE_NV
+#define EGL_CUDA_DEVICE_NV 0x323A
+#endif
+#ifndef EGL_DRM_DEVICE_FILE_EXT
+#define EGL_DRM_DEVICE_FILE_EXT 0x3233
+#endif
+
+bool canEnumerate(const char* clientExtensions)
+{
+    return hasExtension(clientExtensions, "EGL_EXT_device_enumeration") &&
+           hasExtension(clientExtensions, "EGL_EXT_platform_device");
+}
+
+std::vector<EGLDeviceEXT> queryDevices()
+{
+    EGLint count = 0;
+    if (eglQueryDevicesEXT(0, nullptr, &count) != EGL_TRUE || count <= 0)
+        return {};
+    std::vector<EGLDeviceEXT> devices(static_cast<std::size_t>(count));
+    eglQueryDevicesEXT(count, devices.data(), &count);
+    devices.resize(static_cast<std::size_t>(std::max<EGLint>(count, 0)));
+    return devices;
+}
+
+DeviceInfo describe(EGLDeviceEXT device, int index)
+{
+    DeviceInfo info;
+    info.index = index;
+    const char* extensions = eglQueryDeviceStringEXT(device, EGL_EXTENSIONS);
+    info.software = hasExtension(extensions, "EGL_MESA_device_software");
+    if (hasExtension(extensions, "EGL_EXT_device_drm"))
+        if (const char* file = eglQueryDeviceStringEXT(device, EGL_DRM_DEVICE_FILE_EXT))
+            info.drmFile = file;
+    EGLAttrib cuda = 0;
+    if (hasExtension(extensions, "EGL_NV_device_cuda") &&
+        eglQueryDeviceAttribEXT(device, EGL_CUDA_DEVICE_NV, &cuda) == EGL_TRUE)
+        info.cudaId = static_cast<int>(cuda);
+    return info;
+}
+
+std::string describeAll(const std::vector<DeviceInfo>& devices)
+{
+    std::vector<std::string> parts;
+    for (const DeviceInfo& d : devices)
+        parts.push_back(fmt::format("{}: {}{}", d.index,
+                                    d.software ? "software" : d.drmFile.empty() ? "device" : d.drmFile,
+                                    d.cudaId ? fmt::format(", CUDA {}", *d.cudaId) : ""));
+    return parts.empty() ? "none" : fmt::format("{}", fmt::join(parts, "; "));
+}
+
+} // namespace
+
+std::vector<int> deviceOrder(const std::vector<DeviceInfo>& devices, std::optional<int> requested,
+                             const std::optional<std::string>& cudaVisible)
+{
+    const int count = static_cast<int>(devices.size());
+    if (requested)
+        return *requested >= 0 && *requested < count ? std::vector<int>{*requested} : std::vector<int>{};
+    std::vector<int> order;
+    if (cudaVisible && !cudaVisible->empty())
+        for (int i = 0; i < count; ++i)
+            if (devices[static_cast<std::size_t>(i)].cudaId == 0)
+                order.push_back(i);
+    for (int i = 0; i < count; ++i)
+        if (std::find(order.begin(), order.end(), i) == order.end())
+            order.push_back(i);
+    return order;
+}
+
+std::vector<DeviceInfo> EglContext::devices()
+{
+    std::vector<DeviceInfo> infos;
+    if (!canEnumerate(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS)))
+        return infos;
+    const auto devices = queryDevices();
+    for (std::size_t i = 0; i < devices.size(); ++i)
+        infos.push_back(describe(devices[i], static_cast<int>(i)));
+    return infos;
+}
+
 EglContext EglContext::create(bool debug)
 {
+    ContextOptions options;
+    options.debug = debug;
+    return create(options);
+}
+
+EglContext EglContext::create(const ContextOptions& options)
+{
+    const bool debug = options.debug;
     const char* clientExtensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     std::vector<std::string> tried;
     auto state = std::make_unique<State>();
     std::string platform;
+    int deviceUsed = -1;
 
-    // 1. Device platform: enumerate EGL devices and take the first one that gives a context.
-    if (hasExtension(clientExtensions, "EGL_EXT_device_enumeration") &&
-        hasExtension(clientExtensions, "EGL_EXT_platform_device")) {
-        EGLint count = 0;
-        eglQueryDevicesEXT(0, nullptr, &count);
-        std::vector<EGLDeviceEXT> devices(static_cast<std::size_t>(count));
-        if (count > 0)
-            eglQueryDevicesEXT(count, devices.data(), &count);
-        if (count == 0)
+    // 1. Device platform: the devices in deviceOrder()'s order, the first that gives a context.
+    if (canEnumerate(clientExtensions)) {
+        const auto devices = queryDevices();
+        std::vector<DeviceInfo> infos;
+        for (std::size_t i = 0; i < devices.size(); ++i)
+            infos.push_back(describe(devices[i], static_cast<int>(i)));
+        const char* cudaVisible = std::getenv("CUDA_VISIBLE_DEVICES");
+        const auto order = deviceOrder(infos, options.device,
+                                       cudaVisible ? std::optional<std::string>(cudaVisible) : std::nullopt);
+        if (options.device && order.empty())
+            throw ContextError(fmt::format("defocus::gl::EglContext::create(): there is no EGL device {} "
+                                           "(this machine's EGL devices: {})",
+                                           *options.device, describeAll(infos)));
+        if (devices.empty())
             tried.emplace_back("EGL device platform: no devices");
-        for (EGLint i = 0; i < count && platform.empty(); ++i) {
-            const char* deviceExtensions = eglQueryDeviceStringEXT(devices[i], EGL_EXTENSIONS);
-            EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
+        for (const int i : order) {
+            const auto& device = devices[static_cast<std::size_t>(i)];
+            EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
             const std::string why = tryDisplay(display, *state, debug);
             if (why.empty()) {
-                platform = hasExtension(deviceExtensions, "EGL_MESA_device_software") ? "device (software)"
-                                                                                       : "device";
-            } else {
-                tried.push_back(fmt::format("EGL device {}: {}", i, why));
-                state = std::make_unique<State>();
+                platform = infos[static_cast<std::size_t>(i)].software ? "device (software)" : "device";
+                deviceUsed = i;
+                break;
             }
+            tried.push_back(fmt::format("EGL device {}: {}", i, why));
+            state = std::make_unique<State>();
         }
+        if (options.device && platform.empty())
+            throw ContextError(fmt::format("defocus::gl::EglContext::create(): no headless OpenGL 4.5 context ({})",
+                                           fmt::join(tried, "; ")));
     } else {
+        if (options.device)
+            throw ContextError(fmt::format("defocus::gl::EglContext::create(): EGL device {} asked for, but this "
+                                           "EGL cannot list devices (no EGL_EXT_device_enumeration)",
+                                           *options.device));
         tried.emplace_back("EGL device platform: extension not offered");
     }
 
@@ -200,6 +306,7 @@ EglContext EglContext::create(bool debug)
     EglContext context(std::move(state));
     ContextInfo& info = context.info_;
     info.platform = platform;
+    info.device = deviceUsed;
     info.eglVendor = eglQueryString(context.state_->display, EGL_VENDOR);
     info.eglVersion = eglQueryString(context.state_->display, EGL_VERSION);
     info.glVendor = glString(GL_VENDOR);
@@ -215,7 +322,8 @@ EglContext EglContext::create(bool debug)
         glEnable(GL_DEBUG_OUTPUT);
         glDebugMessageCallback(logGlMessage, nullptr);
     }
-    spdlog::debug("EGL {} platform: {} / {}", info.platform, info.glRenderer, info.glVersion);
+    spdlog::debug("EGL {} platform{}: {} / {}", info.platform,
+                  info.device >= 0 ? fmt::format(" (EGL device {})", info.device) : "", info.glRenderer, info.glVersion);
     return context;
 }
 

@@ -1,10 +1,15 @@
 // A headless OpenGL 4.5 core context through EGL, with no window system: the EGL device platform
 // first (what a headless NVIDIA GPU offers), then Mesa's surfaceless platform (llvmpipe on CI).
+// Which device: one asked for by index (defocus --egl-device N), else the GPU that CUDA sees first
+// when CUDA_VISIBLE_DEVICES is set (as Slurm sets it for --gres=gpu), matched through the EGL
+// device's CUDA id where the driver offers EGL_NV_device_cuda, else the devices in order.
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace defocus::gl {
 
@@ -22,7 +27,30 @@ struct ContextInfo {
     std::string glRenderer;  ///< GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
     std::string glVersion;   ///< GL_VERSION
     bool timerQueries = false; ///< GL_TIME_ELAPSED queries give results
+    int device = -1;           ///< index of the EGL device in use; -1 on the surfaceless platform
 };
+
+/// One EGL device, as eglQueryDevicesEXT lists it.
+struct DeviceInfo {
+    int index = 0;
+    std::string drmFile;        ///< EGL_DRM_DEVICE_FILE_EXT, e.g. "/dev/dri/card1"; empty when not offered
+    std::optional<int> cudaId;  ///< EGL_CUDA_DEVICE_NV: the CUDA device it is, as this process's CUDA numbers them
+    bool software = false;      ///< EGL_MESA_device_software (llvmpipe)
+};
+
+struct ContextOptions {
+    bool debug = false; ///< route GL debug messages to the log
+    /// Only this EGL device (an index into devices()); unset: the CUDA device when
+    /// CUDA_VISIBLE_DEVICES names one, else the first device that works, then surfaceless.
+    std::optional<int> device;
+};
+
+/// The order create() tries `devices` in (indices into it): only `requested` when set; else,
+/// when `cudaVisible` names a GPU, the device whose CUDA id is 0 (CUDA numbers the visible GPUs
+/// from 0 in their CUDA_VISIBLE_DEVICES order, and EGL_CUDA_DEVICE_NV gives that number) first,
+/// then the others in order. Pure, for tests.
+std::vector<int> deviceOrder(const std::vector<DeviceInfo>& devices, std::optional<int> requested,
+                             const std::optional<std::string>& cudaVisible);
 
 /// Owns an EGL display + context and makes it current on the creating thread. Move-only.
 class EglContext {
@@ -30,6 +58,11 @@ public:
     /// Creates the context; throws ContextError naming each platform tried and why it failed.
     /// Set `debug` to route GL debug messages to the log.
     static EglContext create(bool debug = false);
+    /// The same with a device choice; an unusable `options.device` throws ContextError naming
+    /// it and the devices there are (no fallback to another device).
+    static EglContext create(const ContextOptions& options);
+    /// The EGL devices of this machine (empty without EGL_EXT_device_enumeration).
+    static std::vector<DeviceInfo> devices();
 
     EglContext(EglContext&&) noexcept;
     EglContext& operator=(EglContext&&) noexcept;
