@@ -1,4 +1,4 @@
-// defocus-bench plan: the per-frame plan against every pass on every pixel (issue 6's "measure
+// defocus-bench plan: the per-frame plan against every pass on every pixel ("measure
 // and record"), on the TUM clip at an open and a closed aperture and on the synthetic clips:
 // ms per frame of each, frames in and out, and how far apart their outputs are.
 //   defocus-bench plan                      (from the repository root; about a minute)

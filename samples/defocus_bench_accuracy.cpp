@@ -67,7 +67,7 @@ struct Options {
 /// The scene and truth measured against, for the plot's title (set by --scene).
 std::string gTruthTitle = "Blender spheres 640x480 vs Cycles thin-lens truth";
 
-/// Figures quoted from ../shared/data/README.md and issue 4 for comparison: not measured here.
+/// Figures quoted from ../shared/data/README.md for comparison: not measured here.
 struct Quoted {
     const char* what;
     const char* psnr;
@@ -261,7 +261,7 @@ cv::Mat paretoPlot(const std::vector<Row>& rows, double unblurredDb)
                 fmt::format("{}: linear PSNR (clipped to [0,1]); unblurred {:.1f} dB", gTruthTitle, unblurredDb),
                 {left, 30}, font, 0.55, ink, 1, cv::LINE_AA);
 
-    // Targets of issue 4 and the quoted Blender point.
+    // The accuracy targets and the quoted Blender point.
     const auto dashedH = [&](double db, const std::string& text) {
         const int y = py(db);
         for (int x = area.x; x < area.x + area.width; x += 12)
@@ -647,7 +647,7 @@ int run(const Options& options, const std::string& commandLine)
     markPareto(rows);
     printTable(rows, unblurred);
 
-    fmt::print("\nQuoted for comparison from ../shared/data/README.md and issue 4 -- NOT measured in this run:\n");
+    fmt::print("\nQuoted for comparison from ../shared/data/README.md -- NOT measured in this run:\n");
     for (const Quoted& q : kQuoted)
         fmt::print("  {:<58}{:>14}   {}\n", q.what, q.psnr, q.time);
     fmt::print("  (this run measured the unblurred input at {:.2f} dB)\n", unblurred.psnrLinear);

@@ -5,7 +5,7 @@
 #   scripts/fuzz-smoke.sh [BUILD_DIR] [SECONDS_PER_TARGET]   (defaults: build-fuzz, 12; 4 targets)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-build=${1:-"$root/build-fuzz"}
+build=$(realpath -m "${1:-"$root/build-fuzz"}")   # absolute: the targets run from a scratch folder
 seconds=${2:-12}
 targets=(fuzz_lists fuzz_depth_decode fuzz_color_decode fuzz_params)
 

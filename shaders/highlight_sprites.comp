@@ -1,5 +1,5 @@
 #version 450 core
-// Bokeh sprites, step 1 of 2 (issue 6, "highlights only where there are highlights"): every
+// Bokeh sprites, step 1 of 2 (highlights only where there are highlights): every
 // blurred pixel whose light the CoC pass gives to a sprite (highlights.glsl) appends one: its
 // position, CoC and that light, to a buffer that is also the instanced draw's indirect command,
 // so that no count comes back to the CPU. It holds the frame's budget of sprites; a frame with

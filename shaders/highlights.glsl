@@ -2,7 +2,7 @@
 // needs coc_params.glsl and common.glsl.
 #include "scene_measurement.glsl"
 
-// Highlights from 8-bit video (issue 6): a light clipped at 255 is far brighter than 1.0, and a
+// Highlights from 8-bit video: a light clipped at 255 is far brighter than 1.0, and a
 // blur of its clipped value spreads a dull grey. Pixels whose brightest channel is within the
 // top 4 % of the range are scaled up towards highlightGain, smoothly from 0.96 to 1.0 (linear),
 // so that lights bloom into bright polygons; only where the pixel will be blurred (|CoC| >= 1 px),

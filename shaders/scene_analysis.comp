@@ -1,5 +1,5 @@
 #version 450 core
-// Scene analysis (issue 6): each invocation measures one 16x16 tile of the frame: its depth
+// Scene analysis: each invocation measures one 16x16 tile of the frame: its depth
 // range, how many of its pixels' |CoC| reach each histogram edge, and its highlight pixels, into
 // one storage buffer that the CPU reads back and sums to make the frame's plan
 // (filter/SceneAnalysis.cpp finishes it: CoC is monotonic in depth, so a tile's CoC range is the

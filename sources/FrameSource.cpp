@@ -13,7 +13,7 @@
 
 #include "sources/FolderPairSource.hpp"
 #include "sources/SingleImageSource.hpp"
-#include "sources/StreamSources.hpp" // streams (issue 5)
+#include "sources/StreamSources.hpp" // cameras and video files
 #include "sources/TumSource.hpp"
 #include "sources/VideoFileSource.hpp"
 
@@ -64,7 +64,7 @@ std::unique_ptr<FrameSource> openSource(const SourceOptions& options)
         throw SourceError(fmt::format(
             "depth scale must be a positive number of units per metre, got {}",
             *options.depthScale));
-    // ---- streams (issue 5): cameras, and video files with a depth sequence ----
+    // ---- streams: cameras, and video files with a depth sequence ----
     if (std::unique_ptr<FrameSource> stream = openStreamSource(options))
         return stream;
 

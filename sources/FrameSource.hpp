@@ -57,7 +57,7 @@ public:
     virtual double frameRate() const { return 0.0; }
     /// One line for logs: kind and location, e.g. "TUM RGB-D sequence data/tum (10 pairs)".
     virtual std::string describe() const = 0;
-    // ---- streams (issue 5) ----
+    // ---- streams ----
     /// True for sources that capture in real time (cameras): they do not end by themselves, and
     /// a consumer slower than the source drops frames rather than queueing them.
     virtual bool isLive() const { return false; }
@@ -71,7 +71,7 @@ struct SourceOptions {
     std::optional<std::filesystem::path> depth;
     /// Units per metre of 16-bit depth images. Unset: 5000 for the TUM layout, 1000 otherwise.
     std::optional<double> depthScale;
-    // ---- streams (issue 5): `input` may also be a camera (/dev/video*), with `depth` a second
+    // ---- streams: `input` may also be a camera (/dev/video*), with `depth` a second
     // camera giving Z16 depth; a video file may take a depth folder or depth.txt (by index).
     /// Capture size asked of a camera, pixels (> 0); the driver picks the nearest it has.
     int width = 640;

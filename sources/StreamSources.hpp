@@ -1,4 +1,4 @@
-// Source selection for streams (issue 5), called by openSource() before the file sources:
+// Source selection for streams, called by openSource() before the file sources:
 //   defocus /dev/video0 [--depth depth.png | depth_dir/ | depth.txt | /dev/video2]
 //   defocus clip.mp4 --depth depth_dir/ | depth.txt            (depth image k for video frame k)
 #pragma once

@@ -1,4 +1,4 @@
-// Issue 3 sections 4 and 5, a failure in the middle of a clip, through the defocus binary: the
+// Bad input and a failure in the middle of a clip, through the defocus binary: the
 // message names the frame's file, the exit status is 1, and the frames before it are kept as
 // complete files (a shorter but playable video, or the sequence's first frames), with no
 // temporary file left. Needs an EGL context to render the frames before the failure.

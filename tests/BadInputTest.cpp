@@ -1,4 +1,4 @@
-// Issue 3 section 4, bad input from disk: every broken file, list or folder gives one message that
+// Bad input from disk: every broken file, list or folder gives one message that
 // names the file (and line or frame), through the library and through the defocus binary, and
 // leaves no output behind. The cases that need frames rendered before the failure are in
 // BadInputGLTest.cpp.

@@ -286,7 +286,7 @@ TEST_F(Passes, RhombusTapsBeyondTheEdgeReadTheFrameMirrored)
     EXPECT_NEAR(cv::mean(out.row(32))[0], 1.0 / 64.0, 0.5 / 64.0);
 }
 
-// Issue 6 section 4: a light clipped in 8-bit video blooms when --highlight-gain scales it up;
+// A light clipped in 8-bit video blooms when --highlight-gain scales it up;
 // frames without clipped pixels, and pixels in focus, are untouched.
 TEST_F(Passes, HighlightRecoveryScalesClippedLightsThatGetBlurred)
 {

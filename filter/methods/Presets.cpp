@@ -30,7 +30,7 @@ const std::vector<Preset>& presets()
     //
     // balanced: half size, where the front's time is nearly flat (the CoC pass, the upscale, the
     // bokeh sprites and the CPU's share are most of the frame, and the taps do not change them);
-    // 6 taps, 2.0 dB over issue 4's 33 dB and Blender's Defocus node (32.9 dB in ~1.4 s), in a
+    // 6 taps, 2.0 dB over the 33 dB target and Blender's Defocus node (32.9 dB in ~1.4 s), in a
     // half of the time of the same kernel at full size. fast: the same at 4 taps, which saves
     // little on llvmpipe (above) but more where the blur passes dominate (a GPU, 4K). high: where
     // the front flattens at full size. McIntosh's chain as published (16 taps, flat top)
