@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -61,6 +62,29 @@ void logToStderr(std::string_view program, bool quiet, bool verbose)
     spdlog::set_default_logger(logger);
     spdlog::set_pattern(fmt::format("%^{}: %l:%$ %v", program));
     spdlog::set_level(verbose ? spdlog::level::debug : quiet ? spdlog::level::warn : spdlog::level::info);
+}
+
+void addCameraOptions(CLI::App& app, SourceOptions& source)
+{
+    app.add_option_function<std::string>(
+           "--size",
+           [&source](const std::string& text) {
+               int width = 0, height = 0;
+               char x = 0;
+               std::istringstream in(text);
+               if (!(in >> width >> x >> height) || (x != 'x' && x != 'X') || !in.eof() || width <= 0 || height <= 0)
+                   throw CLI::ValidationError("--size", "'" + text + "' is not WIDTHxHEIGHT in pixels, e.g. 1280x720");
+               source.width = width;
+               source.height = height;
+           },
+           "Camera capture size WIDTHxHEIGHT, pixels; the driver picks the nearest it has")
+        ->default_str(fmt::format("{}x{}", source.width, source.height));
+    app.add_option("--camera-fps", source.fps, "Camera frame rate to ask for, Hz")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    app.add_option("--pixel-format", source.pixelFormat,
+                   "Camera pixel format, a V4L2 FourCC (YUYV, MJPG, NV12, RGB3, BGR3, GREY) [default: the fastest "
+                   "it offers]");
 }
 
 void catchStopSignals()

@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "samples/ExitStatus.hpp"
+#include "sources/FrameSource.hpp"
 
 namespace defocus::cli {
 
@@ -32,6 +33,10 @@ void logToStderr(std::string_view program, bool quiet = false, bool verbose = fa
 
 /// One line on standard error, "PROGRAM: error: MESSAGE", for use before logToStderr.
 void printError(std::string_view program, std::string_view message);
+
+/// The camera options, the same wherever a camera can be opened: --size WxH, --camera-fps and
+/// --pixel-format, into `source` (its width, height, fps and pixelFormat).
+void addCameraOptions(CLI::App& app, SourceOptions& source);
 
 /// Installs handlers for SIGINT and SIGTERM that only record the signal: the program stops
 /// reading, finalises what it has written and exits with stopStatus().

@@ -68,6 +68,7 @@ struct Options {
     std::string focusPoint;            ///< --focus-point X,Y; "" = the centre
     AutofocusSettings autofocus;       ///< --focus track: --tau
     double depthScaleUsed = 0.0;       ///< the scale the input is read at (for the plausibility check)
+    SourceOptions camera;              ///< --size, --camera-fps, --pixel-format
     std::optional<double> fps;
     std::string timings;
     bool explain = false;
@@ -413,7 +414,9 @@ int runClip(Options options, std::optional<GlSession>& gl, nlohmann::json* repor
         demo = synthetic.get();
         source = std::move(synthetic);
     } else {
-        SourceOptions sourceOptions{options.input, std::nullopt, options.depthScale};
+        SourceOptions sourceOptions = options.camera;
+        sourceOptions.input = options.input;
+        sourceOptions.depthScale = options.depthScale;
         if (!options.depth.empty())
             sourceOptions.depth = options.depth;
         source = openSource(sourceOptions);
@@ -546,6 +549,7 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_flag("-q,--quiet", o.quiet, "Only the summary line and errors");
     app.add_flag("-v,--verbose", o.verbose, "Debug logging");
 
+    cli::addCameraOptions(app, o.camera);
     app.add_flag("-y,--overwrite", o.overwrite, "Replace outputs that exist (without it, an existing output is refused)");
     app.add_option("--codec", o.codec,
                    "Video codec: h264 (default for .mp4), mp4v, ffv1 (lossless, default for .mkv), vp9 (default "

@@ -28,6 +28,7 @@
 #include "samples/ExitStatus.hpp"
 #include "samples/LiveLoop.hpp"
 #include "sinks/DisplaySink.hpp"
+#include "sources/DepthScale.hpp"
 #include "sources/FrameSource.hpp"
 
 namespace {
@@ -38,16 +39,16 @@ struct Options {
     std::string input;
     std::string depth;
     std::optional<double> depthScale;
-    int width = 640;
-    int height = 480;
-    double cameraFps = 30.0;
+    SourceOptions camera; ///< --size, --camera-fps, --pixel-format
     std::string focus = "auto";
     LensSettings lens;
     std::string model = "thin-lens";
     std::string fov = "image-distance";
     std::optional<double> nearM;
     std::optional<double> farM;
-    /// The balanced preset (half size: the fastest setting over 33 dB, docs/accuracy.md).
+    /// --quality, the balanced preset by default (half size: the fastest setting over 33 dB,
+    /// docs/accuracy.md); --samples, --resolution and --near-field override it.
+    std::string qualityPreset = std::string(kDefaultPreset);
     QualitySettings quality = presetSettings(kDefaultPreset);
     std::string resolution = std::string(resolutionName(quality.resolution));
     std::string view = "composite";
@@ -80,9 +81,10 @@ int run(const Options& o)
     if (!o.depth.empty())
         sourceOptions.depth = o.depth;
     sourceOptions.depthScale = o.depthScale;
-    sourceOptions.width = o.width;
-    sourceOptions.height = o.height;
-    sourceOptions.fps = o.cameraFps;
+    sourceOptions.width = o.camera.width;
+    sourceOptions.height = o.camera.height;
+    sourceOptions.fps = o.camera.fps;
+    sourceOptions.pixelFormat = o.camera.pixelFormat;
     std::unique_ptr<FrameSource> source = openSource(sourceOptions);
     // Cameras never block the preview; clips never drop a frame.
     const bool live = source->isLive() || isVideoDevice(o.input);
@@ -126,6 +128,7 @@ int run(const Options& o)
     std::string lastIssues;
     auto lastStep = LiveClock::now();
     int exitCode = kExitDone;
+    bool depthChecked = false;
 
     cli::catchStopSignals();
     try {
@@ -142,6 +145,13 @@ int run(const Options& o)
                     // if it had to wait for the clip's pace.
                     const auto due = o.noPace ? readStart : pacer.wait(fed->frame.timestamp);
                     fed->origin = std::max(readStart, due);
+                }
+                if (fed && !depthChecked) {
+                    const DepthScaleCheck check = checkDepthScale(
+                        fed->frame.depth, o.depthScale.value_or(defaultDepthScale(sourceOptions)), fed->frame.name);
+                    depthChecked = check.validPixels > 0;
+                    if (!check.warning.empty())
+                        spdlog::warn("{}", check.warning);
                 }
                 if (fed) {
                     const double dt = frameInterval(previousTimestamp, fed->frame.timestamp, 1.0 / sourceFps);
@@ -321,11 +331,14 @@ int main(int argc, char** argv)
     app.add_option("--depth-scale", o.depthScale,
                    "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
         ->check(CLI::PositiveNumber);
-    app.add_option("--width", o.width, "Camera capture width, pixels")->check(CLI::PositiveNumber)->capture_default_str();
-    app.add_option("--height", o.height, "Camera capture height, pixels")->check(CLI::PositiveNumber)->capture_default_str();
-    app.add_option("--camera-fps", o.cameraFps, "Camera frame rate to ask for, Hz")
-        ->check(CLI::PositiveNumber)
+    cli::addCameraOptions(app, o.camera);
+    app.add_option("--quality", o.qualityPreset,
+                   "Preset as defocus's: fast (4 taps, half size), balanced (6 taps, half size), high (12 taps, "
+                   "full size); --samples, --resolution and --near-field override it")
+        ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
+    app.add_flag("--near-field,!--no-near-field", o.quality.nearField,
+                 "Spread blurred foreground over what is behind it [default: from --quality]");
     app.add_option("--frames", o.frames, "Stop reading after this many frames")->check(CLI::PositiveNumber);
     app.add_option("--focus", o.focus,
                    "'auto' (autofocus on; click to focus) or a distance in metres / 'inf' (autofocus off)")
@@ -347,10 +360,10 @@ int main(int argc, char** argv)
                    "focal-range model: near limit in metres at the starting focus (2 m with auto); it then follows "
                    "the focus in proportion [default: half the focus]");
     app.add_option("--far", o.farM, "focal-range model: far limit, likewise [default: 3 x the focus]");
-    app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64")->capture_default_str();
-    app.add_option("--resolution", o.resolution, "Size the blurs run at: full or half (the output keeps the frame's)")
-        ->check(CLI::IsMember({"full", "half"}))
-        ->capture_default_str();
+    app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
+    app.add_option("--resolution", o.resolution,
+                   "Size the blurs run at: full or half (the output keeps the frame's) [default: from --quality]")
+        ->check(CLI::IsMember({"full", "half"}));
     app.add_option("--highlight-gain", o.quality.highlightGain,
                    "Scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
         ->capture_default_str();
@@ -387,6 +400,18 @@ int main(int argc, char** argv)
     cli::logToStderr("defocus-preview", o.quiet, o.verbose);
 
     try {
+        {
+            // The preset first, then what was given on its own (as defocus does).
+            QualitySettings quality = presetSettings(o.qualityPreset);
+            quality.highlightGain = o.quality.highlightGain;
+            if (app.count("--samples") > 0)
+                quality.samples = o.quality.samples;
+            if (app.count("--near-field") > 0)
+                quality.nearField = o.quality.nearField;
+            if (app.count("--resolution") == 0)
+                o.resolution = std::string(resolutionName(quality.resolution));
+            o.quality = quality;
+        }
         parseResolution(o.resolution, o.quality.resolution);
         bool autoFocus = false;
         if (!parseFocus(o.focus, o.lens, autoFocus)) {

@@ -78,6 +78,9 @@ struct SourceOptions {
     int height = 480;
     /// Frame rate asked of a camera, Hz (> 0); the driver picks the nearest it has.
     double fps = 30.0;
+    /// Pixel format asked of a colour camera (a V4L2 FourCC name: YUYV, MJPG, NV12, RGB3...);
+    /// "" = the fastest it offers among those defocus decodes.
+    std::string pixelFormat = {};
 };
 
 /// The units per metre openSource reads 16-bit depth at when `options.depthScale` is unset: 5000

@@ -78,6 +78,7 @@ std::unique_ptr<FrameSource> openStreamSource(const SourceOptions& options)
         colour.width = options.width;
         colour.height = options.height;
         colour.fps = options.fps;
+        colour.pixelFormat = options.pixelFormat;
         auto camera = std::make_unique<V4l2Source>(colour);
         if (!options.depth) {
             spdlog::warn("camera {}: no depth given; its frames pass through in focus",
@@ -88,6 +89,7 @@ std::unique_ptr<FrameSource> openStreamSource(const SourceOptions& options)
             V4l2Options depth = colour;
             depth.device = *options.depth;
             depth.role = V4l2Options::Role::Depth;
+            depth.pixelFormat.clear(); // the depth camera's own Z16
             depth.unitsPerMetre = options.depthScale.value_or(defaultUnitsPerMetre);
             return std::make_unique<PairedSource>(
                 std::move(camera),
