@@ -142,13 +142,7 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
         // around its threshold instead of switched: depth noise at the threshold would make the
         // pixel flicker (a tap may carry most of a short line's weight).
         const float rule = nearer ? clamp(tapBlur * bleedingMult, 0.0, 1.0) : 1.0;
-        const float ruled = nearer ? clamp((centerBlur - tapBlur - bleedingBias) / bleedingRamp + 0.5, 0.0, 1.0) : 0.0;
-        float weight = mix(1.0, rule, ruled);
-        // The rule's leak was made for colours up to white: a sharp light in front (HDR, up to
-        // 100 and more) leaking by its blurriness drew a ghost hexagon of it over the blurred
-        // background. Where the rule applies, the leak carries the tap's colour capped at white.
-        const float cap = mix(1.0, 1.0 / max(1.0, max(tap.r, max(tap.g, tap.b))), ruled);
-        const float cap2 = both ? mix(1.0, 1.0 / max(1.0, max(tap2.r, max(tap2.g, tap2.b))), ruled) : 1.0;
+        float weight = mix(1.0, rule, clamp((centerBlur - tapBlur - bleedingBias) / bleedingRamp + 0.5, 0.0, 1.0));
         weight *= clamp(ownLength - float(k) + 0.5, 0.0, 1.0);
 #ifdef NEAR_FIELD
         // Foreground that reaches: soft over the last half pixel of its radius; a segment of
@@ -163,8 +157,8 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
         coverage += share;
         weight *= 1.0 - reach;
 #endif
-        background += tap.rgb * (weight * cap);
-        background2 += tap2 * (weight * cap2);
+        background += tap.rgb * weight;
+        background2 += tap2 * weight;
         backgroundWeight += weight;
     }
     // The bleeding rule may reject every tap: the centre stays (its weight is > 0 whenever the
