@@ -25,10 +25,12 @@ fi
 # a folder of them alone, in order.
 mkdir -p $ref-frames
 n=0
+# (No process substitution: the VM's init mounts no /dev/fd.)
+grep -v '^#' $ref/rgb.txt >/dev/shm/vcam-ref-list.txt
 while read -r _ file; do
   ln -sf "$ref/$file" "$ref-frames/$(printf %06d $n).png"
   n=$((n + 1))
-done < <(grep -v '^#' $ref/rgb.txt)
+done </dev/shm/vcam-ref-list.txt
 say "reference: $n PNGs ($t -> $(now) s)"
 ref=$ref-frames
 
