@@ -22,7 +22,7 @@ export OPENCV_IO_ENABLE_OPENEXR=1
 sections=(
   "tests|the number of tests, by CTest label, and of hard cases|for label in unit gl; do echo \"\$label tests: \$(ctest --test-dir $build -N -L \$label | sed -n 's/^Total Tests: //p')\"; done; echo \"all tests: \$(ctest --test-dir $build -N | sed -n 's/^Total Tests: //p')\"; echo \"hard cases: \$($build/tests/HardCasesGLTest --gtest_list_tests | sed -n 's|^  [^/]*/\\([^ ]*\\)_[a-z]* .*|\\1|p' | sort -u | wc -l), each a test per kernel or preset: \$($build/tests/HardCasesGLTest --gtest_list_tests | grep -c '^  .*/')\""
   "accuracy-tests|balanced, high and McIntosh's chain against the Cycles truth (tests/AccuracyGLTest)|$build/tests/AccuracyGLTest | grep -F '[ FIGURE'"
-  "hard-cases|the hard cases' worst figures per setting (docs/stability.md)|$build/tests/HardCasesGLTest | grep -F '[ FIGURE'"
+  "hard-cases|the hard cases' worst figures per setting (docs/stability.md)|$build/tests/HardCasesGLTest | grep -F '[ hard cases ]'"
   "sprites|bokeh sprites' plateau (tests/HighlightSpritesGLTest)|$build/tests/HighlightSpritesGLTest | grep -F '[ FIGURE'"
   "synthetic-tests|the synthetic truth's bokeh against the filter's CoC (docs/synthetic.md)|$build/tests/SyntheticSceneGLTest | grep -F '[ FIGURE'"
   "speed|ms per pass and per frame, 640x480 and 1920x1080, the balanced preset (README Speed)|$build/defocus-bench --json $out/bench.json"
