@@ -2,6 +2,8 @@
 // frame, then one non-blocking write() per frame of BT.601 YUYV.
 #include "sinks/V4l2OutputSink.hpp"
 
+#include "sources/V4l2Ioctl.hpp"
+
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -22,26 +24,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int xioctl(int fd, unsigned long request, void* arg)
-{
-    int result = 0;
-    do
-        result = ::ioctl(fd, request, arg);
-    while (result == -1 && errno == EINTR);
-    return result;
-}
-
-std::string errorText(int error)
-{
-    return std::system_category().message(error);
-}
-
-template <std::size_t N>
-std::string fieldText(const __u8 (&field)[N])
-{
-    const auto* begin = reinterpret_cast<const char*>(field);
-    return std::string(begin, strnlen(begin, N));
-}
+using v4l2::errorText;
+using v4l2::fieldText;
+using v4l2::xioctl;
 
 std::uint8_t rounded(double value)
 {

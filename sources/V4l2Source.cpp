@@ -2,6 +2,8 @@
 // and the conversion of each buffer into a Frame before the buffer goes back to the driver.
 #include "sources/V4l2Source.hpp"
 
+#include "sources/V4l2Ioctl.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -28,28 +30,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// ioctl, retried when a signal interrupts it.
-int xioctl(int fd, unsigned long request, void* arg)
-{
-    int result = 0;
-    do
-        result = ::ioctl(fd, request, arg);
-    while (result == -1 && errno == EINTR);
-    return result;
-}
-
-std::string errorText(int error)
-{
-    return std::system_category().message(error);
-}
-
-/// The driver's fixed-size string fields (card, driver) as a std::string.
-template <std::size_t N>
-std::string fieldText(const __u8 (&field)[N])
-{
-    const auto* begin = reinterpret_cast<const char*>(field);
-    return std::string(begin, strnlen(begin, N));
-}
+using v4l2::errorText;
+using v4l2::fieldText;
+using v4l2::xioctl;
 
 double monotonicNow()
 {
