@@ -1,5 +1,6 @@
 // Manifest parsing, shards, reports and partial-output removal for defocus --batch (Batch.hpp).
 #include "samples/Batch.hpp"
+#include "samples/BenchMachine.hpp"
 #include "samples/ExitStatus.hpp"
 
 #include <algorithm>
@@ -372,16 +373,6 @@ nlohmann::json buildInfo()
 }
 
 namespace {
-
-std::string utcNow()
-{
-    const std::time_t now = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&now, &tm);
-    char text[32];
-    std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
-    return text;
-}
 
 /// A result line on stdout, whole even with several workers (a scheduler's log is read by scripts).
 void say(const std::string& line)

@@ -1,5 +1,6 @@
-// What the benchmark programs share: when and on which CPU a run was made, and the statistics
-// they report (median and p90 with linear interpolation between order statistics).
+// What the benchmark programs and the batch reports share: when and on which CPU a run was made,
+// and the statistics they report (median and p90 with linear interpolation between order
+// statistics).
 #pragma once
 
 #include <string>
