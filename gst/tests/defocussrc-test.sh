@@ -11,6 +11,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export GST_PLUGIN_PATH=$build/gst GST_REGISTRY=$work/registry.bin
 fail() { echo "defocussrc-test: $*"; exit 1; }
+. "$root/gst/tests/same-frames.sh"
 clip=$root/data/tum_fr1_rpy
 
 # 1. gst-inspect-1.0: exit 0, nothing on stderr, no warning, both pads and the properties.
@@ -33,21 +34,7 @@ gst-launch-1.0 -q defocussrc name=s location="$clip" depth-scale=5000 \
   multifilesink location="$work/gst/%06d.png" \
   s.color ! queue ! d.color  s.depth ! queue ! d.depth || fail "the pipeline failed"
 "$cli" "$clip" -o "$work/cli/" --focus 1.0 --f-number 1.4 -q >/dev/null
-# The CLI's frames keep the clip's TUM names, in rgb.txt's order; numbered links for multifilesrc.
-mkdir -p "$work/cli-seq"
-n=0
-while read -r _ file; do
-  ln -s "$work/cli/$file" "$work/cli-seq/$(printf %06d $n).png"
-  n=$((n + 1))
-done < <(grep -v '^#' "$work/cli/rgb.txt")
-frames=$n
-[ "$(ls "$work/gst" | wc -l)" -eq "$frames" ] || fail "the pipeline gave $(ls "$work/gst" | wc -l) frames, not $frames"
-gst-launch-1.0 -q multifilesrc location="$work/gst/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! \
-  videoconvert ! video/x-raw,format=RGB ! filesink location="$work/gst.rgb"
-gst-launch-1.0 -q multifilesrc location="$work/cli-seq/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! \
-  videoconvert ! video/x-raw,format=RGB ! filesink location="$work/cli.rgb"
-[ -s "$work/cli.rgb" ] || fail "no CLI frames decoded"
-cmp -s "$work/gst.rgb" "$work/cli.rgb" || fail "defocussrc ! defocus frames differ from the CLI's"
+same_frames_as_cli "$work/gst" "$work/cli" "$work" "defocussrc ! defocus"
 echo "defocussrc-test: $frames frames of the TUM folder through defocussrc ! defocus = defocus CLI, byte for byte"
 
 # 3. num-buffers: that many frames on each pad, then the end of the stream.

@@ -10,6 +10,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export GST_PLUGIN_PATH=$build/gst GST_REGISTRY=$work/registry.bin
 fail() { echo "gst-launch-test: $*"; exit 1; }
+. "$root/gst/tests/same-frames.sh"
 
 # 1. gst-inspect-1.0: exit 0, nothing on stderr, no warning in what it prints.
 gst-inspect-1.0 defocus >"$work/inspect.txt" 2>"$work/inspect.err" || fail "gst-inspect-1.0 defocus failed"
@@ -32,32 +33,20 @@ while read -r _ rgb _ depth; do
   ln -s "$root/data/tum_fr1_rpy/$depth" "$work/depth/$n.png"
   i=$((i + 1))
 done <"$root/data/tum_fr1_rpy/associations.txt"
-frames=$i
+inputs=$i
 lens="--focus 1.0 --f-number 1.4"
 for variant in "balanced" "high --hexagon mcintosh"; do
   read -r preset extra <<<"$variant"
   props="autofocus=false focus=1.0 f-number=1.4 depth-scale=5000 quality=$preset"
   [ -n "${extra:-}" ] && props="$props hexagon=mcintosh"
-  rm -rf "$work/gst" "$work/cli" "$work/cli-seq" && mkdir -p "$work/gst" "$work/cli-seq"
+  rm -rf "$work/gst" "$work/cli" && mkdir -p "$work/gst"
   gst-launch-1.0 -q defocus name=d $props ! videoconvert ! pngenc ! multifilesink location="$work/gst/%06d.png" \
     multifilesrc location="$work/rgb/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! d.color \
     multifilesrc location="$work/depth/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! d.depth \
     || fail "the pipeline failed ($variant)"
   "$cli" "$root/data/tum_fr1_rpy" -o "$work/cli/" $lens --quality $preset ${extra:-} -q >/dev/null
-  # The CLI's frames keep the clip's TUM names, in rgb.txt's order; numbered links for multifilesrc.
-  n=0
-  grep -v '^#' "$work/cli/rgb.txt" | while read -r _ file; do
-    ln -s "$work/cli/$file" "$work/cli-seq/$(printf %06d $n).png"
-    n=$((n + 1))
-  done
-  [ "$(ls "$work/gst" | wc -l)" -eq "$frames" ] || fail "the pipeline gave $(ls "$work/gst" | wc -l) frames, not $frames"
-  # Both sets decoded to raw RGB by the same decoder: the pixels must be the same bytes.
-  gst-launch-1.0 -q multifilesrc location="$work/gst/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! \
-    videoconvert ! video/x-raw,format=RGB ! filesink location="$work/gst.rgb"
-  gst-launch-1.0 -q multifilesrc location="$work/cli-seq/%06d.png" caps=image/png,framerate=30/1 ! pngdec ! \
-    videoconvert ! video/x-raw,format=RGB ! filesink location="$work/cli.rgb"
-  [ -s "$work/cli.rgb" ] || fail "no CLI frames decoded"
-  cmp -s "$work/gst.rgb" "$work/cli.rgb" || fail "gst-launch-1.0 frames differ from the CLI's ($variant)"
+  same_frames_as_cli "$work/gst" "$work/cli" "$work" "gst-launch-1.0 ($variant)"
+  [ "$frames" -eq "$inputs" ] || fail "$frames frames out of $inputs in ($variant)"
   echo "gst-launch-test: $frames frames from gst-launch-1.0 = defocus CLI, byte for byte ($variant)"
 done
 
