@@ -87,6 +87,14 @@ void addCameraOptions(CLI::App& app, SourceOptions& source)
                    "it offers]");
 }
 
+std::optional<int> checkLensAndQuality(const LensSettings& lens, const QualitySettings& quality, bool autoFocus)
+{
+    const auto issues = validateCommandLine(lens, quality, autoFocus);
+    for (const auto& issue : issues)
+        spdlog::error("{}", issue.message);
+    return issues.empty() ? std::nullopt : std::optional<int>(kExitUsage);
+}
+
 void catchStopSignals()
 {
     std::signal(SIGINT, onStopSignal);

@@ -17,6 +17,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "filter/Settings.hpp"
 #include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
 
@@ -37,6 +38,10 @@ void printError(std::string_view program, std::string_view message);
 /// The camera options, the same wherever a camera can be opened: --size WxH, --camera-fps and
 /// --pixel-format, into `source` (its width, height, fps and pixelFormat).
 void addCameraOptions(CLI::App& app, SourceOptions& source);
+
+/// Checks the lens and quality the command line gave (validateCommandLine): each problem is
+/// logged as an error and the result is kExitUsage; nullopt when there is none.
+std::optional<int> checkLensAndQuality(const LensSettings& lens, const QualitySettings& quality, bool autoFocus);
 
 /// Installs handlers for SIGINT and SIGTERM that only record the signal: the program stops
 /// reading, finalises what it has written and exits with stopStatus().

@@ -622,12 +622,7 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
         spdlog::error("--focus '{}' is not metres, 'inf', 'auto', 'track' or keys", o.focus);
         return kExitUsage;
     }
-    const auto issues = validateCommandLine(o.lens, o.quality, autoFocus);
-    for (const auto& issue : issues)
-        spdlog::error("{}", issue.message);
-    if (!issues.empty())
-        return kExitUsage;
-    return std::nullopt;
+    return cli::checkLensAndQuality(o.lens, o.quality, autoFocus);
 }
 
 /// One clip with --report: the report is written after the clip, when it is done or failed on

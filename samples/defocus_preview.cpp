@@ -419,11 +419,8 @@ int main(int argc, char** argv)
             return kExitUsage;
         }
         // The command line is checked strictly, like defocus's; keys later clamp with a warning.
-        const auto issues = validateCommandLine(o.lens, o.quality, autoFocus);
-        for (const auto& issue : issues)
-            spdlog::error("{}", issue.message);
-        if (!issues.empty())
-            return kExitUsage;
+        if (const auto status = cli::checkLensAndQuality(o.lens, o.quality, autoFocus))
+            return *status;
         return run(o);
     } catch (const std::exception& error) {
         spdlog::error("{}", error.what());
