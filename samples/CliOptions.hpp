@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "filter/Settings.hpp"
+#include "filter/methods/Presets.hpp"
 #include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
 
@@ -38,6 +39,49 @@ void printError(std::string_view program, std::string_view message);
 /// The camera options, the same wherever a camera can be opened: --size WxH, --camera-fps and
 /// --pixel-format, into `source` (its width, height, fps and pixelFormat).
 void addCameraOptions(CLI::App& app, SourceOptions& source);
+
+/// The lens options as the command line binds them (addLensOptions); finishLens turns the names
+/// into `lens`. --focus is each program's own: defocus takes auto, track and focus keys, the
+/// preview an autofocus that runs all the time.
+struct LensOptions {
+    LensSettings lens;                  ///< --f-number, --focal-length, --sensor-width, --max-coc, ...
+    std::string model = "thin-lens";    ///< --coc-model
+    std::string fov = "image-distance"; ///< --fov-from
+    std::optional<double> nearM;        ///< --near of FocalRange::FollowsFocus (the preview)
+    std::optional<double> farM;         ///< --far of FocalRange::FollowsFocus (the preview)
+};
+
+/// How a program uses --near and --far. The help of both says which the other does.
+enum class FocalRange {
+    Fixed,        ///< defocus: metres, 1 and 6 by default, whatever the focus does
+    FollowsFocus, ///< defocus-preview: metres at the starting focus, then in proportion to it
+};
+
+/// --f-number, --focal-length, --sensor-width, --fov-from, --max-coc, --coc-model, --near, --far
+/// and --blade-rotation, with one name, default and help text in every program.
+void addLensOptions(CLI::App& app, LensOptions& options, FocalRange range);
+/// After parsing: --coc-model and --fov-from into options.lens.
+void finishLens(LensOptions& options);
+
+/// The quality options as the command line binds them (addQualityOptions); finishQuality puts
+/// the preset under what was given on its own.
+struct QualityOptions {
+    std::string qualityPreset = std::string(kDefaultPreset); ///< --quality
+    QualitySettings quality = presetSettings(kDefaultPreset); ///< --samples, --near-field, ...
+    std::string kernel;     ///< --hexagon, "" = the preset's
+    std::string precision;  ///< --precision, "" = the preset's
+    std::string resolution; ///< --resolution, "" = the preset's
+};
+
+/// --quality, --samples, --hexagon, --precision, --resolution, --near-field/--no-near-field,
+/// --highlight-sprites/--no-highlight-sprites and --highlight-gain, the same in every program.
+void addQualityOptions(CLI::App& app, QualityOptions& options);
+/// After parsing `app`: the preset's samples, hexagon, precision, resolution and near field
+/// where the command line gave none, and the names into options.quality.
+void finishQuality(const CLI::App& app, QualityOptions& options);
+
+/// --depth-scale, into `scale` (nullopt: the input's usual scale).
+void addDepthScaleOption(CLI::App& app, std::optional<double>& scale);
 
 /// Checks the lens and quality the command line gave (validateCommandLine): each problem is
 /// logged as an error and the result is kExitUsage; nullopt when there is none.

@@ -45,20 +45,14 @@ namespace {
 
 using namespace defocus;
 
-struct Options {
+/// The command line; the lens and quality options (lens, model, fov, quality, qualityPreset,
+/// kernel, precision, resolution) are the ones every program shares (samples/CliOptions.hpp).
+struct Options : cli::LensOptions, cli::QualityOptions {
     std::string input;
     std::string output;
     std::string depth;
     std::optional<double> depthScale;
     std::string focus = "auto";
-    LensSettings lens;
-    QualitySettings quality;
-    std::string qualityPreset = std::string(kDefaultPreset);
-    std::string model = "thin-lens";
-    std::string fov = "image-distance";
-    std::string precision = "16f";
-    std::string resolution = "full";
-    std::string kernel = "rhombi";
     std::string view = "composite";
     std::string contactSheet;
     std::size_t contactFrame = 0;
@@ -461,52 +455,14 @@ void declareOptions(CLI::App& app, Options& o)
                    "Output: DIR/ (numbered PNGs), FILE.mp4|.mkv|.avi (video), FILE.png (one frame), FILE.exr "
                    "(one frame, linear float)");
     app.add_option("--depth", o.depth, "Depth for INPUT: a folder (paired by sorted name) or one file");
-    app.add_option("--depth-scale", o.depthScale,
-                   "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
-        ->check(CLI::PositiveNumber);
+    cli::addDepthScaleOption(app, o.depthScale);
     app.add_option("--focus", o.focus,
                    "Distance in focus, metres; 'inf' for infinity; 'auto' = median depth of the centre (or "
                    "--focus-point) of the first frame; 'track' = follow it frame by frame (the preview's "
                    "autofocus, --tau); keys such as 0s:1.2,2s:3.5 = a focus pull, eased in dioptres")
         ->capture_default_str();
-    app.add_option("--f-number", o.lens.fNumber, "Aperture as an f-number N (smaller = more blur), 0.7..64")
-        ->capture_default_str();
-    app.add_option("--focal-length", o.lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
-    app.add_option("--sensor-width", o.lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
-        ->capture_default_str();
-    app.add_option("--fov-from", o.fov, "Where the sensor width spans the image: image-distance (a real "
-                   "camera, whose view narrows as it focuses closer) or focal-length (Blender, game engines)")
-        ->check(CLI::IsMember({"image-distance", "focal-length"}))
-        ->capture_default_str();
-    app.add_option("--max-coc", o.lens.maxCocPx, "Largest blur diameter, pixels, 0..512")->capture_default_str();
-    app.add_option("--coc-model", o.model,
-                   "thin-lens (physical) or focal-range (blur rises linearly from --focus to max at --near/--far)")
-        ->check(CLI::IsMember({"thin-lens", "focal-range"}))
-        ->capture_default_str();
-    app.add_option("--near", o.lens.nearLimitM, "focal-range model: metres where near blur reaches --max-coc")
-        ->capture_default_str();
-    app.add_option("--far", o.lens.farLimitM, "focal-range model: metres where far blur reaches --max-coc")
-        ->capture_default_str();
-    app.add_option("--quality", o.qualityPreset,
-                   "Preset from the accuracy benchmark (docs/accuracy.md), all rhombi with their near field: fast (4 "
-                   "taps, half size), balanced (6 taps, half size), high (12 taps, full size); --samples, "
-                   "--precision, --resolution, --hexagon and --near-field override it")
-        ->check(CLI::IsMember({"fast", "balanced", "high"}))
-        ->capture_default_str();
-    app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
-    app.add_option("--hexagon", o.kernel,
-                   "How the blurs make the hexagon: rhombi (three one-sided rhombi summed, keeps highlight energy) "
-                   "or mcintosh (McIntosh et al. 2012, min of two) [default: from --quality]")
-        ->check(CLI::IsMember({"rhombi", "mcintosh"}));
-    app.add_option("--blade-rotation", o.lens.bladeRotationDeg,
-                   "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top (as Blender Cycles), 30 = flat top")
-        ->capture_default_str();
-    app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
-        ->check(CLI::IsMember({"16f", "32f"}));
-    app.add_option("--resolution", o.resolution,
-                   "Size the blurs run at: full, or half (a quarter of the pixels; the output keeps the frame's "
-                   "size and its in-focus pixels) [default: from --quality]")
-        ->check(CLI::IsMember({"full", "half"}));
+    cli::addLensOptions(app, o, cli::FocalRange::Fixed);
+    cli::addQualityOptions(app, o);
     std::vector<std::string> views;
     for (const View v : kAllViews)
         views.emplace_back(viewName(v));
@@ -529,15 +485,6 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_option("--fps", o.fps, "Frame rate of a video output, Hz [default: the input's]")->check(CLI::PositiveNumber);
     app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
     app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
-    app.add_option("--highlight-gain", o.quality.highlightGain,
-                   "8-bit input: scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
-        ->capture_default_str();
-    app.add_flag("--near-field,!--no-near-field", o.quality.nearField,
-                 "Spread blurred foreground over what is behind it [default: from --quality]");
-    app.add_flag("--highlight-sprites,!--no-highlight-sprites", o.quality.highlightSprites,
-                 "Rhombi: lights brighter than white scatter as hexagons with exact edges (bokeh sprites) "
-                 "[default: on]")
-        ->capture_default_str();
     app.add_flag("--always-on", o.alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
     app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
     app.add_flag("--demo", o.demo,
@@ -550,7 +497,9 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_flag("-v,--verbose", o.verbose, "Debug logging");
 
     cli::addCameraOptions(app, o.camera);
-    app.add_flag("-y,--overwrite", o.overwrite, "Replace outputs that exist (without it, an existing output is refused)");
+    app.add_flag("-y,--overwrite", o.overwrite,
+                 "Replace outputs that exist (without it, an existing output is refused); --batch replaces the "
+                 "output of each clip it runs (no report yet, or --redo) with or without it");
     app.add_option("--codec", o.codec,
                    "Video codec: h264 (default for .mp4), mp4v, ffv1 (lossless, default for .mkv), vp9 (default "
                    "for .webm), mjpg (default for .avi)")
@@ -590,23 +539,9 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
         spdlog::error("INPUT and -o OUTPUT are required (see --help)");
         return kExitUsage;
     }
-    const QualitySettings fromPreset = presetSettings(o.qualityPreset);
-    if (app.count("--samples") == 0)
-        o.quality.samples = fromPreset.samples;
-    if (app.count("--precision") == 0)
-        o.precision = fromPreset.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
-    if (app.count("--hexagon") == 0)
-        o.kernel = std::string(kernelName(fromPreset.kernel));
-    if (app.count("--near-field") == 0)
-        o.quality.nearField = fromPreset.nearField;
-    if (app.count("--resolution") == 0)
-        o.resolution = std::string(resolutionName(fromPreset.resolution));
+    cli::finishQuality(app, o);
     o.quality.adaptive = !o.alwaysOn;
-    o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
-    parseFieldOfView(o.fov, o.lens.fieldOfView); // checked by CLI11
-    o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
-    parseKernel(o.kernel, o.quality.kernel);
-    parseResolution(o.resolution, o.quality.resolution);
+    cli::finishLens(o);
     try {
         std::optional<cv::Point2d> point;
         if (!o.focusPoint.empty())
