@@ -10,10 +10,13 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "filter/ApiSettings.hpp"
 #include "filter/Autofocus.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Pipeline.hpp"
+#include "filter/SceneAnalysis.hpp"
 #include "filter/Settings.hpp"
+#include "filter/Views.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
 #include "filter/methods/Presets.hpp"
@@ -31,66 +34,6 @@ constexpr double kFallbackFrameS = 1.0 / 30.0;
 /// The command line's `--focus auto`: median of the central 10 %, 2 m where it has no depth.
 constexpr double kAutoWindow = 0.1;
 constexpr float kAutoFallbackM = 2.0f;
-
-std::string_view presetName(Quality::Preset preset)
-{
-    switch (preset) {
-    case Quality::Preset::Fast: return "fast";
-    case Quality::Preset::High: return "high";
-    default: return "balanced";
-    }
-}
-
-LensSettings toLens(const Lens& lens)
-{
-    LensSettings out;
-    out.model = lens.cocModel == Lens::Model::FocalRange ? CocModel::FocalRange : CocModel::ThinLens;
-    out.focalLengthMm = lens.focalLengthMm;
-    out.fNumber = lens.fNumber;
-    out.focusM = lens.focusM;
-    out.sensorWidthMm = lens.sensorWidthMm;
-    out.fieldOfView = lens.fovFrom == Lens::FovFrom::FocalLength ? FieldOfView::FocalLength : FieldOfView::ImageDistance;
-    out.maxCocPx = lens.maxCocPx;
-    out.bladeRotationDeg = lens.bladeRotationDeg;
-    out.nearLimitM = lens.nearM;
-    out.farLimitM = lens.farM;
-    return out;
-}
-
-void fromLens(const LensSettings& in, Lens& lens)
-{
-    lens.focalLengthMm = in.focalLengthMm;
-    lens.fNumber = in.fNumber;
-    lens.focusM = in.focusM;
-    lens.sensorWidthMm = in.sensorWidthMm;
-    lens.maxCocPx = in.maxCocPx;
-    lens.bladeRotationDeg = in.bladeRotationDeg;
-    lens.nearM = in.nearLimitM;
-    lens.farM = in.farLimitM;
-}
-
-/// The preset's samples, precision, kernel, near field and resolution unless set, as the
-/// command line fills what its flags leave out; every other field as the command line's.
-QualitySettings toQuality(const Quality& quality)
-{
-    const QualitySettings preset = presetSettings(presetName(quality.preset));
-    QualitySettings out;
-    out.samples = quality.samples.value_or(preset.samples);
-    out.targetFormat = quality.precision ? (*quality.precision == Quality::Precision::F32 ? TargetFormat::Rgba32F
-                                                                                          : TargetFormat::Rgba16F)
-                                         : preset.targetFormat;
-    out.kernel = quality.hexagon ? (*quality.hexagon == Quality::Hexagon::McIntosh ? HexagonKernel::McIntoshMin
-                                                                                   : HexagonKernel::RhombiSum)
-                                 : preset.kernel;
-    out.nearField = quality.nearField.value_or(preset.nearField);
-    out.resolution = quality.resolution ? (*quality.resolution == Quality::Resolution::Half ? Resolution::Half
-                                                                                            : Resolution::Full)
-                                        : preset.resolution;
-    out.highlightSprites = quality.highlightSprites;
-    out.highlightGain = quality.highlightGain;
-    out.adaptive = !quality.alwaysOn;
-    return out;
-}
 
 View toView(Settings::View view)
 {
@@ -161,6 +104,45 @@ std::vector<std::string> check(Settings& settings, bool clamp)
     return issues;
 }
 
+Quality resolve(const Quality& quality)
+{
+    return resolveQuality(quality);
+}
+
+std::vector<EglDevice> eglDevices()
+{
+    std::vector<EglDevice> out;
+    for (const auto& d : gl::EglContext::devices())
+        out.push_back({d.index, d.software, d.drmFile, d.cudaId});
+    return out;
+}
+
+namespace {
+
+RendererInfo toRendererInfo(const gl::ContextInfo& info)
+{
+    return {info.platform,  info.device,     info.eglVendor, info.eglVersion,
+            info.glVendor,  info.glRenderer, info.glVersion, info.timerQueries};
+}
+
+gl::ContextOptions toContextOptions(const ContextOptions& options)
+{
+    gl::ContextOptions out;
+    out.device = options.eglDevice;
+    return out;
+}
+
+} // namespace
+
+RendererInfo probeRenderer(const ContextOptions& context)
+{
+    try {
+        return toRendererInfo(gl::EglContext::create(toContextOptions(context)).info());
+    } catch (const gl::ContextError& error) {
+        throw GlError(error.what());
+    }
+}
+
 std::string version()
 {
     return DEFOCUS_VERSION;
@@ -178,8 +160,14 @@ struct Filter::Impl {
     double previousTimestamp = 0.0;
     std::size_t frames = 0;
     FrameReport report;
+    /// The last process()'s frame and lens, for contactSheet() to process it again.
+    std::optional<Frame> lastFrame;
+    LensSettings lastLens;
 
     explicit Impl(gl::EglContext made) : context(std::move(made)) {}
+
+    /// report from the pipeline's last frame (frame number `frames`).
+    void fillReport();
 
     void bind()
     {
@@ -212,13 +200,15 @@ struct Filter::Impl {
     }
 };
 
-Filter::Filter(const Settings& settings)
+Filter::Filter(const Settings& settings) : Filter(settings, ContextOptions{}) {}
+
+Filter::Filter(const Settings& settings, const ContextOptions& context)
 {
     Settings checked = settings;
     if (const auto issues = check(checked); !issues.empty())
         throw SettingsError(issues.front());
     try {
-        impl_ = std::make_unique<Impl>(gl::EglContext::create());
+        impl_ = std::make_unique<Impl>(gl::EglContext::create(toContextOptions(context)));
         impl_->pipeline.emplace();
     } catch (const gl::ContextError& error) {
         throw GlError(error.what());
@@ -322,11 +312,20 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     const Encoding encoding =
         p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
     cv::Mat out = p.pipeline->run(frame, lens, p.quality, toView(p.settings.view), encoding);
+    p.lastFrame = std::move(frame);
+    p.lastLens = lens;
+    p.fillReport();
+    ++p.frames;
+    return out;
+}
 
+void Filter::Impl::fillReport()
+{
+    Impl& p = *this;
     const FrameTimings& t = p.pipeline->timings();
     FrameReport& r = p.report;
-    r.index = p.frames++;
-    r.focusM = lens.focusM;
+    r.index = p.frames;
+    r.focusM = p.lastLens.focusM;
     r.timings.totalMs = t.totalMs;
     r.timings.depthPrepMs = t.depthPrepMs;
     r.timings.analysisMs = t.analysisMs;
@@ -348,7 +347,6 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     r.plan.nearField = plan.nearField;
     r.plan.highlightSprites = plan.highlightSprites;
     r.plan.explain = plan.explain(analysis);
-    return out;
 }
 
 const FrameReport& Filter::lastFrame() const
@@ -356,10 +354,44 @@ const FrameReport& Filter::lastFrame() const
     return impl_->report;
 }
 
+std::vector<Timings::Pass> Filter::finishGpuTimings()
+{
+    impl_->bind();
+    std::vector<Timings::Pass> out;
+    for (const auto& pass : impl_->pipeline->drainGpuTimes())
+        out.push_back({pass.name, pass.ms});
+    return out;
+}
+
+cv::Mat Filter::contactSheet()
+{
+    Impl& p = *impl_;
+    if (!p.lastFrame)
+        throw InputError("contact sheet: no frame processed yet");
+    p.bind();
+    Pipeline& pipeline = *p.pipeline;
+    std::vector<std::pair<std::string, cv::Mat>> tiles;
+    int number = 1;
+    for (const View v : kAllViews)
+        tiles.emplace_back(fmt::format("{} {}", number++, viewName(v)), pipeline.read(v, Encoding::Srgb8));
+    tiles.emplace_back("plan: blur tiles outlined, copied dimmed, near field blue",
+                       drawTileMap(tiles.front().second, pipeline.plan(), pipeline.analysis()));
+    cv::Mat sheet = defocus::contactSheet(tiles);
+    // Processed again so that the timings are a plain frame's, not the views' reads.
+    const Encoding encoding =
+        p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
+    pipeline.run(*p.lastFrame, p.lastLens, p.quality, toView(p.settings.view), encoding);
+    --p.frames;
+    p.fillReport();
+    ++p.frames;
+    return sheet;
+}
+
 void Filter::reset()
 {
     Impl& p = *impl_;
     p.frames = 0;
+    p.lastFrame.reset();
     p.focusChosen = false;
     p.previousTimestamp = 0.0;
     p.report = {};
@@ -378,6 +410,11 @@ void Filter::release()
 std::string Filter::renderer() const
 {
     return impl_->context.info().glRenderer;
+}
+
+RendererInfo Filter::rendererInfo() const
+{
+    return toRendererInfo(impl_->context.info());
 }
 
 } // namespace defocus

@@ -18,7 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "filter/Settings.hpp"
-#include "filter/methods/Presets.hpp"
+#include "defocus/Settings.hpp"
 #include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
 
@@ -40,11 +40,10 @@ void printError(std::string_view program, std::string_view message);
 /// --pixel-format, into `source` (its width, height, fps and pixelFormat).
 void addCameraOptions(CLI::App& app, SourceOptions& source);
 
-/// The lens options as the command line binds them (addLensOptions); finishLens turns the names
-/// into `lens`. --focus is each program's own: defocus takes auto, track and focus keys, the
-/// preview an autofocus that runs all the time.
-struct LensOptions {
-    LensSettings lens;                  ///< --f-number, --focal-length, --sensor-width, --max-coc, ...
+/// What the lens options hold besides the public Lens they fill (addLensOptions): the names
+/// finishLens turns into its enums, and the preview's focal range. --focus is each program's own:
+/// defocus takes auto, track and focus keys, the preview an autofocus that runs all the time.
+struct LensNames {
     std::string model = "thin-lens";    ///< --coc-model
     std::string fov = "image-distance"; ///< --fov-from
     std::optional<double> nearM;        ///< --near of FocalRange::FollowsFocus (the preview)
@@ -58,27 +57,29 @@ enum class FocalRange {
 };
 
 /// --f-number, --focal-length, --sensor-width, --fov-from, --max-coc, --coc-model, --near, --far
-/// and --blade-rotation, with one name, default and help text in every program.
-void addLensOptions(CLI::App& app, LensOptions& options, FocalRange range);
-/// After parsing: --coc-model and --fov-from into options.lens.
-void finishLens(LensOptions& options);
+/// and --blade-rotation into `lens` and `names`, with one name, default and help text in every
+/// program (the public API's words: include/defocus/Settings.hpp).
+void addLensOptions(CLI::App& app, Lens& lens, LensNames& names, FocalRange range);
+/// After parsing: --coc-model and --fov-from into `lens`.
+void finishLens(const LensNames& names, Lens& lens);
 
-/// The quality options as the command line binds them (addQualityOptions); finishQuality puts
-/// the preset under what was given on its own.
-struct QualityOptions {
-    std::string qualityPreset = std::string(kDefaultPreset); ///< --quality
-    QualitySettings quality = presetSettings(kDefaultPreset); ///< --samples, --near-field, ...
-    std::string kernel;     ///< --hexagon, "" = the preset's
-    std::string precision;  ///< --precision, "" = the preset's
-    std::string resolution; ///< --resolution, "" = the preset's
+/// What the quality options hold besides the public Quality they fill (addQualityOptions): the
+/// names as given, and as resolved by finishQuality (a report's words).
+struct QualityNames {
+    std::string qualityPreset = "balanced"; ///< --quality
+    bool nearField = false;                  ///< --near-field / --no-near-field, when given
+    std::string kernel;                      ///< --hexagon
+    std::string precision;                   ///< --precision
+    std::string resolution;                  ///< --resolution
 };
 
 /// --quality, --samples, --hexagon, --precision, --resolution, --near-field/--no-near-field,
-/// --highlight-sprites/--no-highlight-sprites and --highlight-gain, the same in every program.
-void addQualityOptions(CLI::App& app, QualityOptions& options);
-/// After parsing `app`: the preset's samples, hexagon, precision, resolution and near field
-/// where the command line gave none, and the names into options.quality.
-void finishQuality(const CLI::App& app, QualityOptions& options);
+/// --highlight-sprites/--no-highlight-sprites and --highlight-gain into `quality` and `names`,
+/// the same in every program.
+void addQualityOptions(CLI::App& app, Quality& quality, QualityNames& names);
+/// After parsing `app`: the options given into `quality`, then the preset's value for every one
+/// not given (defocus::resolve); `names` then say what runs.
+void finishQuality(const CLI::App& app, QualityNames& names, Quality& quality);
 
 /// --depth-scale, into `scale` (nullopt: the input's usual scale).
 void addDepthScaleOption(CLI::App& app, std::optional<double>& scale);

@@ -23,6 +23,7 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "filter/ApiSettings.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
 #include "filter/Pipeline.hpp"
@@ -47,8 +48,9 @@ using Json = nlohmann::ordered_json;
 /// Exit codes: 0 done, 1 runtime failure (data, GL, output), 2 bad command line.
 
 /// The command line; --quality and the options that override it are defocus's
-/// (cli::addQualityOptions), resolved by cli::finishQuality.
-struct Options : cli::QualityOptions {
+/// (cli::addQualityOptions), resolved by cli::finishQuality into `quality`.
+struct Options : cli::QualityNames {
+    Quality quality;
     std::string data = "data/tum_fr1_rpy";
     std::vector<std::string> sizes = {"640x480", "1920x1080"};
     int runs = 15;
@@ -352,7 +354,7 @@ int run(const Options& options, const std::string& commandLine)
     for (const std::string& text : options.sizes)
         sizes.push_back(parseSize(text));
 
-    QualitySettings quality = options.quality; // the preset under the options given (finishQuality)
+    QualitySettings quality = toQuality(options.quality); // the preset under the options given
     quality.adaptive = !options.noAdaptive;
     const std::string precision = quality.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
     LensSettings baseLens;
@@ -579,7 +581,7 @@ int main(int argc, char** argv)
     app.add_option("--warmup", o.warmup, "Unmeasured frames first, per size and scene")
         ->check(CLI::Range(0, 1000))
         ->capture_default_str();
-    cli::addQualityOptions(app, o);
+    cli::addQualityOptions(app, o.quality, o);
     app.add_option("--focus", o.focusM, "Distance in focus, metres")->capture_default_str();
     app.add_option("--f-number", o.fNumber, "Aperture as an f-number")->capture_default_str();
     app.add_option("--focal-length", o.focalLengthMm, "Focal length, millimetres")->capture_default_str();
@@ -593,7 +595,7 @@ int main(int argc, char** argv)
     if (const auto status = cli::parse(app, argc, argv))
         return *status;
     cli::logToStderr("defocus-bench");
-    cli::finishQuality(app, o);
+    cli::finishQuality(app, o, o.quality);
     spdlog::set_level(spdlog::level::warn); // keep the library's info lines out of the table
 
     try {

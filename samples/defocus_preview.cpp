@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/ApiSettings.hpp"
 #include "filter/Autofocus.hpp"
 #include "filter/Pipeline.hpp"
 #include "filter/Settings.hpp"
@@ -35,10 +36,15 @@ namespace {
 
 using namespace defocus;
 
-/// The command line; the lens and quality options (lens, model, fov, nearM, farM, quality,
-/// qualityPreset, ...) are the ones every program shares (samples/CliOptions.hpp), --quality the
-/// balanced preset by default as defocus's.
-struct Options : cli::LensOptions, cli::QualityOptions {
+/// The command line. The lens and quality options (lensGiven, qualityGiven and their names:
+/// model, fov, nearM, farM, qualityPreset, ...) are the ones every program shares
+/// (samples/CliOptions.hpp), --quality the balanced preset by default as defocus's; `lens` and
+/// `quality` are the pipeline's, made from them.
+struct Options : cli::LensNames, cli::QualityNames {
+    Lens lensGiven;
+    Quality qualityGiven;
+    LensSettings lens;
+    QualitySettings quality;
     std::string input;
     std::string depth;
     std::optional<double> depthScale;
@@ -325,8 +331,8 @@ int main(int argc, char** argv)
     app.add_option("--focus", o.focus,
                    "'auto' (autofocus on; click to focus) or a distance in metres / 'inf' (autofocus off)")
         ->capture_default_str();
-    cli::addLensOptions(app, o, cli::FocalRange::FollowsFocus);
-    cli::addQualityOptions(app, o);
+    cli::addLensOptions(app, o.lensGiven, o, cli::FocalRange::FollowsFocus);
+    cli::addQualityOptions(app, o.qualityGiven, o);
     std::vector<std::string> views;
     for (const View v : kAllViews)
         views.emplace_back(viewName(v));
@@ -357,8 +363,10 @@ int main(int argc, char** argv)
     cli::logToStderr("defocus-preview", o.quiet, o.verbose);
 
     try {
-        cli::finishQuality(app, o);
-        cli::finishLens(o);
+        cli::finishQuality(app, o, o.qualityGiven);
+        cli::finishLens(o, o.lensGiven);
+        o.lens = toLens(o.lensGiven);
+        o.quality = toQuality(o.qualityGiven);
         bool autoFocus = false;
         if (!parseFocus(o.focus, o.lens, autoFocus)) {
             spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);

@@ -2,7 +2,7 @@
 # Builds the Containerfile with podman and checks the image: defocus runs in it (--version, --info
 # on Mesa's llvmpipe, two frames of the bundled clip through --batch, a report written), and the
 # final stage holds no compiler (no gcc, g++, cc, c++) and no -dev package.
-#   scripts/container-test.sh           (CTest: ctest -L container; slow: 25 min on 2 busy cores
+#   scripts/container-test.sh           (CTest: ctest -L container; slow: 21 min on 2 busy cores
 #                                        with podman's layer cache warm, more on a fresh machine)
 # Exit: 0 passed, 1 failed, 77 skipped, with the reason: not root (rootful podman), podman, runc
 # or debootstrap missing and not installable, or no network to the Debian mirror that the image's
