@@ -111,6 +111,7 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
     const float step = max(baseStep, extent / float(MAX_TAPS));
     const float length = extent / step;       // in steps
     const float ownLength = radius / step;    // the centre's own blur, in steps
+    const float halfPerStep = 0.5 / step;     // a CoC diameter to a radius in steps
     const int taps = int(ceil(length - 0.5)); // pieces k >= 1 that start inside the segment
     // Spread taps leave the lattice and are filtered; the switch fades over the first quarter
     // of a step so that the output stays continuous in the CoC.
@@ -154,7 +155,7 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
         // background's blur: in focus or just in front of it (the bleeding rule's fallback
         // weight, or its full weight below the rule's bias), or at the edge of its own bokeh.
         const float ownPiece = clamp(ownLength - float(k) + 0.5, 0.0, 1.0);
-        const float tapPiece = clamp(0.5 * abs(tap.a) / step - float(k) + 0.5, 0.0, 1.0);
+        const float tapPiece = clamp(abs(tap.a) * halfPerStep - float(k) + 0.5, 0.0, 1.0);
         const float unreached = nearer ? clamp(1.0 - tapPiece / max(ownPiece, 1e-6), 0.0, 1.0) : 0.0;
         weight *= mix(1.0, 1.0 / max(luminance(tap.rgb), 1.0), max(unreached, nearer ? bleeding : 0.0));
         weight *= ownPiece;
