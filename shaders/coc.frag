@@ -34,8 +34,9 @@ layout(std430, binding = 2) readonly buffer SpriteCount {
 // the frame.
 vec4 pixel(ivec2 texel)
 {
-    const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
-    const vec3 color = blurColor(texelFetch(uColor, texel, 0).rgb, coc);
+    const vec3 raw = texelFetch(uColor, texel, 0).rgb;
+    const float coc = signedCoc(lightDepth(uColor, uDepth, texel, luminance(raw)));
+    const vec3 color = blurColor(raw, coc);
     const bool drawn = highlightThreshold > 0.0 && spriteHeader[5] <= spriteHeader[4];
     return vec4(drawn ? color * spriteShare(color, coc, texel, textureSize(uColor, 0)) : color, coc);
 }
