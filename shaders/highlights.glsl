@@ -26,8 +26,8 @@ vec3 blurColor(vec3 color, float coc)
 // mixes the light with what lies behind it, and a renderer's depth (or a sensor's) gives such a
 // pixel one depth, often the background's: its share of the light then took the background's
 // blur, a pale hexagon as large as that blur around a light in front of it (overlapping-lights
-// in the corpus: 24.68 -> 26.94 dB, balanced). Nearer only: a light seen beside a nearer
-// occluder (a railing's bar) keeps the bar's edge pixels where they are.
+// in the corpus: 24.68 -> 26.94 dB, balanced). Nearer only: a light beside a nearer occluder
+// whose antialiased edge is above white (a railing's bar in front of it) keeps its own depth.
 float lightDepth(sampler2D colorTexture, sampler2D depthTexture, ivec2 texel, float brightness)
 {
     float depth = texelFetch(depthTexture, texel, 0).r;

@@ -25,11 +25,12 @@
 //
 // Bleeding: a tap nearer than the centre and sharper than it is weighted by its blurriness as in
 // the paper (bleedingBias/bleedingMult); such a tap above white, or any nearer one whose own blur
-// does not reach the centre, counts by white's worth of its light (no ghost of a light in front). NEAR_FIELD, "scatter as gather" (Jimenez 2014): each
-// line reaches as far as the largest foreground blur that can reach this pixel (tile maxima
-// dilated on the CPU); a nearer tap that is blurrier than the centre counts where its own radius
-// reaches the centre, with the coverage a scattered segment of its length would give, and lies
-// over the centre's own blur by that coverage. FIRST_PASS and NEAR_FIELD are compile-time
+// does not reach the centre, counts by white's worth of its light (no ghost of a light in
+// front). NEAR_FIELD, "scatter as gather" (Jimenez 2014): each line reaches as far as the
+// largest foreground blur that can reach this pixel (tile maxima dilated on the CPU); a nearer
+// tap that is blurrier than the centre counts where its own radius reaches the centre, with the
+// coverage a scattered segment of its length would give, and lies over the centre's own blur by
+// that coverage. FIRST_PASS and NEAR_FIELD are compile-time
 // variants: llvmpipe pays for every instruction of a branch on a uniform. FUSED (second pass
 // only) writes the composite (A + 2B) / 3 itself, to one target: the output.
 #include "common.glsl"
