@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "filter/ApiSettings.hpp"
 #include "filter/Autofocus.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Pipeline.hpp"
@@ -33,66 +34,6 @@ constexpr double kFallbackFrameS = 1.0 / 30.0;
 /// The command line's `--focus auto`: median of the central 10 %, 2 m where it has no depth.
 constexpr double kAutoWindow = 0.1;
 constexpr float kAutoFallbackM = 2.0f;
-
-std::string_view presetName(Quality::Preset preset)
-{
-    switch (preset) {
-    case Quality::Preset::Fast: return "fast";
-    case Quality::Preset::High: return "high";
-    default: return "balanced";
-    }
-}
-
-LensSettings toLens(const Lens& lens)
-{
-    LensSettings out;
-    out.model = lens.cocModel == Lens::Model::FocalRange ? CocModel::FocalRange : CocModel::ThinLens;
-    out.focalLengthMm = lens.focalLengthMm;
-    out.fNumber = lens.fNumber;
-    out.focusM = lens.focusM;
-    out.sensorWidthMm = lens.sensorWidthMm;
-    out.fieldOfView = lens.fovFrom == Lens::FovFrom::FocalLength ? FieldOfView::FocalLength : FieldOfView::ImageDistance;
-    out.maxCocPx = lens.maxCocPx;
-    out.bladeRotationDeg = lens.bladeRotationDeg;
-    out.nearLimitM = lens.nearM;
-    out.farLimitM = lens.farM;
-    return out;
-}
-
-void fromLens(const LensSettings& in, Lens& lens)
-{
-    lens.focalLengthMm = in.focalLengthMm;
-    lens.fNumber = in.fNumber;
-    lens.focusM = in.focusM;
-    lens.sensorWidthMm = in.sensorWidthMm;
-    lens.maxCocPx = in.maxCocPx;
-    lens.bladeRotationDeg = in.bladeRotationDeg;
-    lens.nearM = in.nearLimitM;
-    lens.farM = in.farLimitM;
-}
-
-/// The preset's samples, precision, kernel, near field and resolution unless set, as the
-/// command line fills what its flags leave out; every other field as the command line's.
-QualitySettings toQuality(const Quality& quality)
-{
-    const QualitySettings preset = presetSettings(presetName(quality.preset));
-    QualitySettings out;
-    out.samples = quality.samples.value_or(preset.samples);
-    out.targetFormat = quality.precision ? (*quality.precision == Quality::Precision::F32 ? TargetFormat::Rgba32F
-                                                                                          : TargetFormat::Rgba16F)
-                                         : preset.targetFormat;
-    out.kernel = quality.hexagon ? (*quality.hexagon == Quality::Hexagon::McIntosh ? HexagonKernel::McIntoshMin
-                                                                                   : HexagonKernel::RhombiSum)
-                                 : preset.kernel;
-    out.nearField = quality.nearField.value_or(preset.nearField);
-    out.resolution = quality.resolution ? (*quality.resolution == Quality::Resolution::Half ? Resolution::Half
-                                                                                            : Resolution::Full)
-                                        : preset.resolution;
-    out.highlightSprites = quality.highlightSprites;
-    out.highlightGain = quality.highlightGain;
-    out.adaptive = !quality.alwaysOn;
-    return out;
-}
 
 View toView(Settings::View view)
 {
@@ -165,14 +106,7 @@ std::vector<std::string> check(Settings& settings, bool clamp)
 
 Quality resolve(const Quality& quality)
 {
-    const QualitySettings q = toQuality(quality);
-    Quality out = quality;
-    out.samples = q.samples;
-    out.hexagon = q.kernel == HexagonKernel::McIntoshMin ? Quality::Hexagon::McIntosh : Quality::Hexagon::Rhombi;
-    out.precision = q.targetFormat == TargetFormat::Rgba32F ? Quality::Precision::F32 : Quality::Precision::F16;
-    out.resolution = q.resolution == Resolution::Half ? Quality::Resolution::Half : Quality::Resolution::Full;
-    out.nearField = q.nearField;
-    return out;
+    return resolveQuality(quality);
 }
 
 std::vector<EglDevice> eglDevices()

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "defocus/Filter.hpp"
+#include "filter/ApiSettings.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
 #include "sources/FrameSource.hpp"
@@ -86,6 +87,114 @@ void addCameraOptions(CLI::App& app, SourceOptions& source)
     app.add_option("--pixel-format", source.pixelFormat,
                    "Camera pixel format, a V4L2 FourCC (YUYV, MJPG, NV12, RGB3, BGR3, GREY) [default: the fastest "
                    "it offers]");
+}
+
+void addLensOptions(CLI::App& app, Lens& lens, LensNames& names, FocalRange range)
+{
+    app.add_option("--f-number", lens.fNumber, "Aperture as an f-number N (smaller = more blur), 0.7..64")
+        ->capture_default_str();
+    app.add_option("--focal-length", lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
+    app.add_option("--sensor-width", lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
+        ->capture_default_str();
+    app.add_option("--fov-from", names.fov, "Where the sensor width spans the image: image-distance (a real "
+                   "camera, whose view narrows as it focuses closer) or focal-length (Blender, game engines)")
+        ->check(CLI::IsMember({"image-distance", "focal-length"}))
+        ->capture_default_str();
+    app.add_option("--max-coc", lens.maxCocPx, "Largest blur diameter, pixels, 0..512")->capture_default_str();
+    app.add_option("--coc-model", names.model,
+                   "thin-lens (physical) or focal-range (blur rises linearly from --focus to max at --near/--far)")
+        ->check(CLI::IsMember({"thin-lens", "focal-range"}))
+        ->capture_default_str();
+    // The one deliberate difference between the programs: the preview's focus moves all the time
+    // (autofocus, taps, keys), so its range moves with it; defocus's range is where it is put.
+    const Lens defaults;
+    if (range == FocalRange::Fixed) {
+        app.add_option("--near", lens.nearM,
+                       "focal-range model: metres where near blur reaches --max-coc, fixed (defocus-preview's "
+                       "follows its focus: by default half the focus)")
+            ->capture_default_str();
+        app.add_option("--far", lens.farM,
+                       "focal-range model: metres where far blur reaches --max-coc, fixed (defocus-preview's "
+                       "follows its focus: by default 3 x the focus)")
+            ->capture_default_str();
+    } else {
+        app.add_option("--near", names.nearM,
+                       fmt::format("focal-range model: metres where near blur reaches --max-coc at the starting "
+                                   "focus, then follows the focus in proportion (defocus's stays at {:g} m) "
+                                   "[default: half the focus]",
+                                   defaults.nearM));
+        app.add_option("--far", names.farM,
+                       fmt::format("focal-range model: metres where far blur reaches --max-coc at the starting "
+                                   "focus, then follows the focus in proportion (defocus's stays at {:g} m) "
+                                   "[default: 3 x the focus]",
+                                   defaults.farM));
+    }
+    app.add_option("--blade-rotation", lens.bladeRotationDeg,
+                   "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top (as Blender Cycles), 30 = flat top")
+        ->capture_default_str();
+}
+
+void finishLens(const LensNames& names, Lens& lens)
+{
+    // The names are checked by CLI11.
+    lens.cocModel = names.model == "focal-range" ? Lens::Model::FocalRange : Lens::Model::ThinLens;
+    lens.fovFrom = names.fov == "focal-length" ? Lens::FovFrom::FocalLength : Lens::FovFrom::ImageDistance;
+}
+
+void addQualityOptions(CLI::App& app, Quality& quality, QualityNames& names)
+{
+    app.add_option("--quality", names.qualityPreset,
+                   "Preset from the accuracy benchmark (docs/accuracy.md), all rhombi with their near field: fast (4 "
+                   "taps, half size), balanced (6 taps, half size), high (12 taps, full size); --samples, "
+                   "--precision, --resolution, --hexagon and --near-field override it")
+        ->check(CLI::IsMember({"fast", "balanced", "high"}))
+        ->capture_default_str();
+    app.add_option("--samples", quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
+    app.add_option("--hexagon", names.kernel,
+                   "How the blurs make the hexagon: rhombi (three one-sided rhombi summed, keeps highlight energy) "
+                   "or mcintosh (McIntosh et al. 2012, min of two) [default: from --quality]")
+        ->check(CLI::IsMember({"rhombi", "mcintosh"}));
+    app.add_option("--precision", names.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
+        ->check(CLI::IsMember({"16f", "32f"}));
+    app.add_option("--resolution", names.resolution,
+                   "Size the blurs run at: full, or half (a quarter of the pixels; the output keeps the frame's "
+                   "size and its in-focus pixels) [default: from --quality]")
+        ->check(CLI::IsMember({"full", "half"}));
+    app.add_flag("--near-field,!--no-near-field", names.nearField,
+                 "Spread blurred foreground over what is behind it [default: from --quality]");
+    app.add_flag("--highlight-sprites,!--no-highlight-sprites", quality.highlightSprites,
+                 "Rhombi: lights brighter than white scatter as hexagons with exact edges (bokeh sprites) "
+                 "[default: on]")
+        ->capture_default_str();
+    app.add_option("--highlight-gain", quality.highlightGain,
+                   "8-bit input: scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
+        ->capture_default_str();
+}
+
+void finishQuality(const CLI::App& app, QualityNames& names, Quality& q)
+{
+    // The names are checked by CLI11; the options given override the preset.
+    q.preset = parsePreset(names.qualityPreset).value_or(Quality::Preset::Balanced);
+    if (app.count("--precision") > 0)
+        q.precision = names.precision == "32f" ? Quality::Precision::F32 : Quality::Precision::F16;
+    if (app.count("--hexagon") > 0)
+        q.hexagon = names.kernel == "mcintosh" ? Quality::Hexagon::McIntosh : Quality::Hexagon::Rhombi;
+    if (app.count("--near-field") > 0)
+        q.nearField = names.nearField;
+    if (app.count("--resolution") > 0)
+        q.resolution = names.resolution == "half" ? Quality::Resolution::Half : Quality::Resolution::Full;
+    q = resolveQuality(q);
+    names.precision = *q.precision == Quality::Precision::F32 ? "32f" : "16f";
+    names.kernel = *q.hexagon == Quality::Hexagon::McIntosh ? "mcintosh" : "rhombi";
+    names.resolution = *q.resolution == Quality::Resolution::Half ? "half" : "full";
+    names.nearField = *q.nearField;
+}
+
+void addDepthScaleOption(CLI::App& app, std::optional<double>& scale)
+{
+    app.add_option("--depth-scale", scale,
+                   "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
+        ->check(CLI::PositiveNumber);
 }
 
 std::optional<int> checkLensAndQuality(const LensSettings& lens, const QualitySettings& quality, bool autoFocus)

@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "filter/Settings.hpp"
+#include "defocus/Settings.hpp"
 #include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
 
@@ -38,6 +39,50 @@ void printError(std::string_view program, std::string_view message);
 /// The camera options, the same wherever a camera can be opened: --size WxH, --camera-fps and
 /// --pixel-format, into `source` (its width, height, fps and pixelFormat).
 void addCameraOptions(CLI::App& app, SourceOptions& source);
+
+/// What the lens options hold besides the public Lens they fill (addLensOptions): the names
+/// finishLens turns into its enums, and the preview's focal range. --focus is each program's own:
+/// defocus takes auto, track and focus keys, the preview an autofocus that runs all the time.
+struct LensNames {
+    std::string model = "thin-lens";    ///< --coc-model
+    std::string fov = "image-distance"; ///< --fov-from
+    std::optional<double> nearM;        ///< --near of FocalRange::FollowsFocus (the preview)
+    std::optional<double> farM;         ///< --far of FocalRange::FollowsFocus (the preview)
+};
+
+/// How a program uses --near and --far. The help of both says which the other does.
+enum class FocalRange {
+    Fixed,        ///< defocus: metres, 1 and 6 by default, whatever the focus does
+    FollowsFocus, ///< defocus-preview: metres at the starting focus, then in proportion to it
+};
+
+/// --f-number, --focal-length, --sensor-width, --fov-from, --max-coc, --coc-model, --near, --far
+/// and --blade-rotation into `lens` and `names`, with one name, default and help text in every
+/// program (the public API's words: include/defocus/Settings.hpp).
+void addLensOptions(CLI::App& app, Lens& lens, LensNames& names, FocalRange range);
+/// After parsing: --coc-model and --fov-from into `lens`.
+void finishLens(const LensNames& names, Lens& lens);
+
+/// What the quality options hold besides the public Quality they fill (addQualityOptions): the
+/// names as given, and as resolved by finishQuality (a report's words).
+struct QualityNames {
+    std::string qualityPreset = "balanced"; ///< --quality
+    bool nearField = false;                  ///< --near-field / --no-near-field, when given
+    std::string kernel;                      ///< --hexagon
+    std::string precision;                   ///< --precision
+    std::string resolution;                  ///< --resolution
+};
+
+/// --quality, --samples, --hexagon, --precision, --resolution, --near-field/--no-near-field,
+/// --highlight-sprites/--no-highlight-sprites and --highlight-gain into `quality` and `names`,
+/// the same in every program.
+void addQualityOptions(CLI::App& app, Quality& quality, QualityNames& names);
+/// After parsing `app`: the options given into `quality`, then the preset's value for every one
+/// not given (defocus::resolve); `names` then say what runs.
+void finishQuality(const CLI::App& app, QualityNames& names, Quality& quality);
+
+/// --depth-scale, into `scale` (nullopt: the input's usual scale).
+void addDepthScaleOption(CLI::App& app, std::optional<double>& scale);
 
 /// Checks the lens and quality the command line gave (validateCommandLine): each problem is
 /// logged as an error and the result is kExitUsage; nullopt when there is none.

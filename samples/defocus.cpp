@@ -27,6 +27,7 @@
 
 #include "defocus/Filter.hpp"
 #include "defocus/Settings.hpp"
+#include "filter/ApiSettings.hpp"
 #include "samples/Batch.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
@@ -44,7 +45,10 @@ namespace {
 
 using namespace defocus;
 
-struct Options {
+/// The command line. The lens and quality options and their names (model, fov, qualityPreset,
+/// nearField, kernel, precision, resolution: as given, then as resolved, the report's words) are
+/// the ones every program shares (samples/CliOptions.hpp).
+struct Options : cli::LensNames, cli::QualityNames {
     std::string input;
     std::string output;
     std::string depth;
@@ -53,13 +57,6 @@ struct Options {
     /// The lens and quality (every field resolved by finishOptions), the view; the output's
     /// encoding is the sink's, the focus is set frame by frame.
     Settings settings;
-    bool nearField = false;            ///< --near-field / --no-near-field, when given
-    std::string qualityPreset = "balanced";
-    std::string model = "thin-lens";
-    std::string fov = "image-distance";
-    std::string precision = "16f";     ///< as given, then as resolved (the report's words)
-    std::string resolution = "full";
-    std::string kernel = "rhombi";
     std::string view = "composite";
     std::string contactSheet;
     std::size_t contactFrame = 0;
@@ -100,23 +97,6 @@ ContextOptions contextOptions(const Options& options)
 
 /// --view's names, in the order of Settings::View.
 constexpr const char* kViewNames[] = {"input", "horizontal", "diagonal-a", "diagonal-b", "composite", "depth", "coc"};
-
-/// --demo's synthetic source (sources/, the tree's own) takes the pipeline's lens type.
-LensSettings demoLens(const Lens& lens)
-{
-    LensSettings out;
-    out.model = lens.cocModel == Lens::Model::FocalRange ? CocModel::FocalRange : CocModel::ThinLens;
-    out.focalLengthMm = lens.focalLengthMm;
-    out.fNumber = lens.fNumber;
-    out.focusM = lens.focusM;
-    out.sensorWidthMm = lens.sensorWidthMm;
-    out.fieldOfView = lens.fovFrom == Lens::FovFrom::FocalLength ? FieldOfView::FocalLength : FieldOfView::ImageDistance;
-    out.maxCocPx = lens.maxCocPx;
-    out.bladeRotationDeg = lens.bladeRotationDeg;
-    out.nearLimitM = lens.nearM;
-    out.farLimitM = lens.farM;
-    return out;
-}
 
 int printInfo(const Options& options)
 {
@@ -223,7 +203,7 @@ std::unique_ptr<SyntheticSource> openDemo(const Options& options)
 {
     SyntheticSettings settings;
     settings.frames = options.frames.value_or(60);
-    settings.lens = demoLens(options.settings.lens);
+    settings.lens = toLens(options.settings.lens); // --demo's synthetic source takes the pipeline's lens type
     settings.focusPull = options.focus == "auto";
     return std::make_unique<SyntheticSource>(syntheticScene(options.demoScene), settings);
 }
@@ -478,54 +458,14 @@ void declareOptions(CLI::App& app, Options& o)
                    "Output: DIR/ (numbered PNGs), FILE.mp4|.mkv|.avi (video), FILE.png (one frame), FILE.exr "
                    "(one frame, linear float)");
     app.add_option("--depth", o.depth, "Depth for INPUT: a folder (paired by sorted name) or one file");
-    app.add_option("--depth-scale", o.depthScale,
-                   "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
-        ->check(CLI::PositiveNumber);
+    cli::addDepthScaleOption(app, o.depthScale);
     app.add_option("--focus", o.focus,
                    "Distance in focus, metres; 'inf' for infinity; 'auto' = median depth of the centre (or "
                    "--focus-point) of the first frame; 'track' = follow it frame by frame (the preview's "
                    "autofocus, --tau); keys such as 0s:1.2,2s:3.5 = a focus pull, eased in dioptres")
         ->capture_default_str();
-    Lens& lens = o.settings.lens;
-    Quality& quality = o.settings.quality;
-    app.add_option("--f-number", lens.fNumber, "Aperture as an f-number N (smaller = more blur), 0.7..64")
-        ->capture_default_str();
-    app.add_option("--focal-length", lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
-    app.add_option("--sensor-width", lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
-        ->capture_default_str();
-    app.add_option("--fov-from", o.fov, "Where the sensor width spans the image: image-distance (a real "
-                   "camera, whose view narrows as it focuses closer) or focal-length (Blender, game engines)")
-        ->check(CLI::IsMember({"image-distance", "focal-length"}))
-        ->capture_default_str();
-    app.add_option("--max-coc", lens.maxCocPx, "Largest blur diameter, pixels, 0..512")->capture_default_str();
-    app.add_option("--coc-model", o.model,
-                   "thin-lens (physical) or focal-range (blur rises linearly from --focus to max at --near/--far)")
-        ->check(CLI::IsMember({"thin-lens", "focal-range"}))
-        ->capture_default_str();
-    app.add_option("--near", lens.nearM, "focal-range model: metres where near blur reaches --max-coc")
-        ->capture_default_str();
-    app.add_option("--far", lens.farM, "focal-range model: metres where far blur reaches --max-coc")
-        ->capture_default_str();
-    app.add_option("--quality", o.qualityPreset,
-                   "Preset from the accuracy benchmark (docs/accuracy.md), all rhombi with their near field: fast (4 "
-                   "taps, half size), balanced (6 taps, half size), high (12 taps, full size); --samples, "
-                   "--precision, --resolution, --hexagon and --near-field override it")
-        ->check(CLI::IsMember({"fast", "balanced", "high"}))
-        ->capture_default_str();
-    app.add_option("--samples", quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
-    app.add_option("--hexagon", o.kernel,
-                   "How the blurs make the hexagon: rhombi (three one-sided rhombi summed, keeps highlight energy) "
-                   "or mcintosh (McIntosh et al. 2012, min of two) [default: from --quality]")
-        ->check(CLI::IsMember({"rhombi", "mcintosh"}));
-    app.add_option("--blade-rotation", lens.bladeRotationDeg,
-                   "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top (as Blender Cycles), 30 = flat top")
-        ->capture_default_str();
-    app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
-        ->check(CLI::IsMember({"16f", "32f"}));
-    app.add_option("--resolution", o.resolution,
-                   "Size the blurs run at: full, or half (a quarter of the pixels; the output keeps the frame's "
-                   "size and its in-focus pixels) [default: from --quality]")
-        ->check(CLI::IsMember({"full", "half"}));
+    cli::addLensOptions(app, o.settings.lens, o, cli::FocalRange::Fixed);
+    cli::addQualityOptions(app, o.settings.quality, o);
     const std::vector<std::string> views(std::begin(kViewNames), std::end(kViewNames));
     app.add_option("--view", o.view, "What to write: " + fmt::format("{}", fmt::join(views, ", ")))
         ->check(CLI::IsMember(views))
@@ -546,16 +486,7 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_option("--fps", o.fps, "Frame rate of a video output, Hz [default: the input's]")->check(CLI::PositiveNumber);
     app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
     app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
-    app.add_option("--highlight-gain", quality.highlightGain,
-                   "8-bit input: scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
-        ->capture_default_str();
-    app.add_flag("--near-field,!--no-near-field", o.nearField,
-                 "Spread blurred foreground over what is behind it [default: from --quality]");
-    app.add_flag("--highlight-sprites,!--no-highlight-sprites", quality.highlightSprites,
-                 "Rhombi: lights brighter than white scatter as hexagons with exact edges (bokeh sprites) "
-                 "[default: on]")
-        ->capture_default_str();
-    app.add_flag("--always-on", quality.alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
+    app.add_flag("--always-on", o.settings.quality.alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
     app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
     app.add_flag("--demo", o.demo,
                  "No INPUT: render a synthetic clip (60 frames, a focus pull; --frames sets its length) and blur "
@@ -567,7 +498,9 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_flag("-v,--verbose", o.verbose, "Debug logging");
 
     cli::addCameraOptions(app, o.camera);
-    app.add_flag("-y,--overwrite", o.overwrite, "Replace outputs that exist (without it, an existing output is refused)");
+    app.add_flag("-y,--overwrite", o.overwrite,
+                 "Replace outputs that exist (without it, an existing output is refused); --batch replaces the "
+                 "output of each clip it runs (no report yet, or --redo) with or without it");
     app.add_option("--codec", o.codec,
                    "Video codec: h264 (default for .mp4), mp4v, ffv1 (lossless, default for .mkv), vp9 (default "
                    "for .webm), mjpg (default for .avi)")
@@ -622,26 +555,8 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
         spdlog::error("INPUT and -o OUTPUT are required (see --help)");
         return kExitUsage;
     }
-    // The names are checked by CLI11; the flags given override the preset (defocus::resolve).
-    Quality& q = o.settings.quality;
-    q.preset = o.qualityPreset == "fast" ? Quality::Preset::Fast
-               : o.qualityPreset == "high" ? Quality::Preset::High
-                                           : Quality::Preset::Balanced;
-    if (app.count("--precision") > 0)
-        q.precision = o.precision == "32f" ? Quality::Precision::F32 : Quality::Precision::F16;
-    if (app.count("--hexagon") > 0)
-        q.hexagon = o.kernel == "mcintosh" ? Quality::Hexagon::McIntosh : Quality::Hexagon::Rhombi;
-    if (app.count("--near-field") > 0)
-        q.nearField = o.nearField;
-    if (app.count("--resolution") > 0)
-        q.resolution = o.resolution == "half" ? Quality::Resolution::Half : Quality::Resolution::Full;
-    q = resolve(q);
-    o.precision = *q.precision == Quality::Precision::F32 ? "32f" : "16f";
-    o.kernel = *q.hexagon == Quality::Hexagon::McIntosh ? "mcintosh" : "rhombi";
-    o.resolution = *q.resolution == Quality::Resolution::Half ? "half" : "full";
-    Lens& lens = o.settings.lens;
-    lens.cocModel = o.model == "focal-range" ? Lens::Model::FocalRange : Lens::Model::ThinLens;
-    lens.fovFrom = o.fov == "focal-length" ? Lens::FovFrom::FocalLength : Lens::FovFrom::ImageDistance;
+    cli::finishQuality(app, o, o.settings.quality);
+    cli::finishLens(o, o.settings.lens);
     for (std::size_t v = 0; v < std::size(kViewNames); ++v)
         if (o.view == kViewNames[v])
             o.settings.view = static_cast<Settings::View>(v);
@@ -663,7 +578,7 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
             spdlog::error("--focus '{}' is not metres, 'inf', 'auto', 'track' or keys", o.focus);
             return kExitUsage;
         }
-        lens.focusM = *metres;
+        o.settings.lens.focusM = *metres;
     }
     Settings checked = o.settings;
     if (autoFocus)

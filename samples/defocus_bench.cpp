@@ -23,6 +23,7 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "filter/ApiSettings.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
 #include "filter/Pipeline.hpp"
@@ -46,17 +47,14 @@ using Json = nlohmann::ordered_json;
 
 /// Exit codes: 0 done, 1 runtime failure (data, GL, output), 2 bad command line.
 
-struct Options {
+/// The command line; --quality and the options that override it are defocus's
+/// (cli::addQualityOptions), resolved by cli::finishQuality into `quality`.
+struct Options : cli::QualityNames {
+    Quality quality;
     std::string data = "data/tum_fr1_rpy";
     std::vector<std::string> sizes = {"640x480", "1920x1080"};
     int runs = 15;
     int warmup = 3;
-    std::string preset = "balanced";
-    std::optional<int> samples;        ///< overrides the preset's
-    std::optional<std::string> resolution;
-    std::optional<std::string> precision;
-    std::optional<std::string> kernel; ///< "rhombi" or "mcintosh"
-    std::optional<bool> nearField;
     double focusM = 1.0;
     double fNumber = 2.0;
     double focalLengthMm = 50.0;
@@ -356,17 +354,7 @@ int run(const Options& options, const std::string& commandLine)
     for (const std::string& text : options.sizes)
         sizes.push_back(parseSize(text));
 
-    QualitySettings quality = presetSettings(options.preset);
-    if (options.samples)
-        quality.samples = *options.samples;
-    if (options.precision)
-        quality.targetFormat = *options.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
-    if (options.kernel)
-        parseKernel(*options.kernel, quality.kernel);
-    if (options.resolution)
-        parseResolution(*options.resolution, quality.resolution);
-    if (options.nearField)
-        quality.nearField = *options.nearField;
+    QualitySettings quality = toQuality(options.quality); // the preset under the options given
     quality.adaptive = !options.noAdaptive;
     const std::string precision = quality.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
     LensSettings baseLens;
@@ -402,7 +390,7 @@ int run(const Options& options, const std::string& commandLine)
                info.glRenderer, info.glVersion, info.platform, cpu, cores, loadBefore);
     fmt::print("clip: {} ({} frames, cycled); --quality {}: {} {} taps{}, {} size, {}, {}; {} runs after {} warm-up "
                "frames per scene\n",
-               options.data, clip.size(), options.preset, kernelName(quality.kernel), quality.samples,
+               options.data, clip.size(), options.qualityPreset, kernelName(quality.kernel), quality.samples,
                quality.nearField ? " + near field" : "", resolutionName(quality.resolution),
                precision == "32f" ? "RGBA32F" : "RGBA16F",
                quality.adaptive ? "adaptive (in-focus frames and tiles skipped)" : "every pass on every pixel",
@@ -474,7 +462,7 @@ int run(const Options& options, const std::string& commandLine)
              {{"data", options.data},
               {"runs", options.runs},
               {"warmup", options.warmup},
-              {"preset", options.preset},
+              {"preset", options.qualityPreset},
               {"kernel", kernelName(quality.kernel)},
               {"nearField", quality.nearField},
               {"samples", quality.samples},
@@ -593,19 +581,7 @@ int main(int argc, char** argv)
     app.add_option("--warmup", o.warmup, "Unmeasured frames first, per size and scene")
         ->check(CLI::Range(0, 1000))
         ->capture_default_str();
-    app.add_option("--quality", o.preset, "Preset (docs/accuracy.md): fast, balanced or high")
-        ->check(CLI::IsMember({"fast", "balanced", "high"}))
-        ->capture_default_str();
-    app.add_option("--samples", o.samples, "Taps per directional blur, 2..64 [default: from --quality]");
-    app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
-        ->check(CLI::IsMember({"16f", "32f"}));
-    app.add_option("--resolution", o.resolution, "Size of the blurs: full or half [default: from --quality]")
-        ->check(CLI::IsMember({"full", "half"}));
-    app.add_option("--hexagon", o.kernel, "rhombi or mcintosh [default: from --quality]")
-        ->check(CLI::IsMember({"rhombi", "mcintosh"}));
-    bool nearField = false;
-    CLI::Option* nearFieldOption = app.add_flag("--near-field,!--no-near-field", nearField,
-                                                "Spread blurred foreground over what is behind it [default: from --quality]");
+    cli::addQualityOptions(app, o.quality, o);
     app.add_option("--focus", o.focusM, "Distance in focus, metres")->capture_default_str();
     app.add_option("--f-number", o.fNumber, "Aperture as an f-number")->capture_default_str();
     app.add_option("--focal-length", o.focalLengthMm, "Focal length, millimetres")->capture_default_str();
@@ -619,8 +595,7 @@ int main(int argc, char** argv)
     if (const auto status = cli::parse(app, argc, argv))
         return *status;
     cli::logToStderr("defocus-bench");
-    if (nearFieldOption->count() > 0)
-        o.nearField = nearField;
+    cli::finishQuality(app, o, o.quality);
     spdlog::set_level(spdlog::level::warn); // keep the library's info lines out of the table
 
     try {

@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/ApiSettings.hpp"
 #include "filter/Autofocus.hpp"
 #include "filter/Pipeline.hpp"
 #include "filter/Settings.hpp"
@@ -35,22 +36,20 @@ namespace {
 
 using namespace defocus;
 
-struct Options {
+/// The command line. The lens and quality options (lensGiven, qualityGiven and their names:
+/// model, fov, nearM, farM, qualityPreset, ...) are the ones every program shares
+/// (samples/CliOptions.hpp), --quality the balanced preset by default as defocus's; `lens` and
+/// `quality` are the pipeline's, made from them.
+struct Options : cli::LensNames, cli::QualityNames {
+    Lens lensGiven;
+    Quality qualityGiven;
+    LensSettings lens;
+    QualitySettings quality;
     std::string input;
     std::string depth;
     std::optional<double> depthScale;
     SourceOptions camera; ///< --size, --camera-fps, --pixel-format
     std::string focus = "auto";
-    LensSettings lens;
-    std::string model = "thin-lens";
-    std::string fov = "image-distance";
-    std::optional<double> nearM;
-    std::optional<double> farM;
-    /// --quality, the balanced preset by default (half size: the fastest setting over 33 dB,
-    /// docs/accuracy.md); --samples, --resolution and --near-field override it.
-    std::string qualityPreset = std::string(kDefaultPreset);
-    QualitySettings quality = presetSettings(kDefaultPreset);
-    std::string resolution = std::string(resolutionName(quality.resolution));
     std::string view = "composite";
     AutofocusSettings autofocus;
     std::optional<std::size_t> frames;
@@ -91,9 +90,7 @@ int run(const Options& o)
     const double sourceFps = source->frameRate() > 0.0 ? source->frameRate() : 30.0;
 
     LiveControls controls;
-    controls.lens = o.lens;
-    controls.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
-    parseFieldOfView(o.fov, controls.lens.fieldOfView); // checked by CLI11
+    controls.lens = o.lens; // finishLens has set its model and field of view
     parseView(o.view, controls.view); // checked by CLI11
     controls.autofocus = o.focus == "auto";
     Autofocus autofocus(o.autofocus);
@@ -328,48 +325,14 @@ int main(int argc, char** argv)
     app.add_option("input", o.input, "Colour input: /dev/videoN, video file, TUM folder, image folder or image")
         ->required();
     app.add_option("--depth", o.depth, "Depth for INPUT: one image (fixed camera), a folder, depth.txt, or /dev/videoN");
-    app.add_option("--depth-scale", o.depthScale,
-                   "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
-        ->check(CLI::PositiveNumber);
+    cli::addDepthScaleOption(app, o.depthScale);
     cli::addCameraOptions(app, o.camera);
-    app.add_option("--quality", o.qualityPreset,
-                   "Preset as defocus's: fast (4 taps, half size), balanced (6 taps, half size), high (12 taps, "
-                   "full size); --samples, --resolution and --near-field override it")
-        ->check(CLI::IsMember({"fast", "balanced", "high"}))
-        ->capture_default_str();
-    app.add_flag("--near-field,!--no-near-field", o.quality.nearField,
-                 "Spread blurred foreground over what is behind it [default: from --quality]");
     app.add_option("--frames", o.frames, "Stop reading after this many frames")->check(CLI::PositiveNumber);
     app.add_option("--focus", o.focus,
                    "'auto' (autofocus on; click to focus) or a distance in metres / 'inf' (autofocus off)")
         ->capture_default_str();
-    app.add_option("--f-number", o.lens.fNumber, "Aperture as an f-number N, 0.7..64 (+/- keys: 1/3 stop)")
-        ->capture_default_str();
-    app.add_option("--focal-length", o.lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
-    app.add_option("--sensor-width", o.lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
-        ->capture_default_str();
-    app.add_option("--fov-from", o.fov, "Where the sensor width spans the image: image-distance (a real "
-                   "camera, whose view narrows as it focuses closer) or focal-length (Blender, game engines)")
-        ->check(CLI::IsMember({"image-distance", "focal-length"}))
-        ->capture_default_str();
-    app.add_option("--max-coc", o.lens.maxCocPx, "Largest blur diameter, pixels, 0..512 ([ ] keys)")->capture_default_str();
-    app.add_option("--coc-model", o.model, "thin-lens or focal-range (m key)")
-        ->check(CLI::IsMember({"thin-lens", "focal-range"}))
-        ->capture_default_str();
-    app.add_option("--near", o.nearM,
-                   "focal-range model: near limit in metres at the starting focus (2 m with auto); it then follows "
-                   "the focus in proportion [default: half the focus]");
-    app.add_option("--far", o.farM, "focal-range model: far limit, likewise [default: 3 x the focus]");
-    app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
-    app.add_option("--resolution", o.resolution,
-                   "Size the blurs run at: full or half (the output keeps the frame's) [default: from --quality]")
-        ->check(CLI::IsMember({"full", "half"}));
-    app.add_option("--highlight-gain", o.quality.highlightGain,
-                   "Scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
-        ->capture_default_str();
-    app.add_option("--blade-rotation", o.lens.bladeRotationDeg,
-                   "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top, 30 = flat top")
-        ->capture_default_str();
+    cli::addLensOptions(app, o.lensGiven, o, cli::FocalRange::FollowsFocus);
+    cli::addQualityOptions(app, o.qualityGiven, o);
     std::vector<std::string> views;
     for (const View v : kAllViews)
         views.emplace_back(viewName(v));
@@ -400,24 +363,21 @@ int main(int argc, char** argv)
     cli::logToStderr("defocus-preview", o.quiet, o.verbose);
 
     try {
-        {
-            // The preset first, then what was given on its own (as defocus does).
-            QualitySettings quality = presetSettings(o.qualityPreset);
-            quality.highlightGain = o.quality.highlightGain;
-            if (app.count("--samples") > 0)
-                quality.samples = o.quality.samples;
-            if (app.count("--near-field") > 0)
-                quality.nearField = o.quality.nearField;
-            if (app.count("--resolution") == 0)
-                o.resolution = std::string(resolutionName(quality.resolution));
-            o.quality = quality;
-        }
-        parseResolution(o.resolution, o.quality.resolution);
+        cli::finishQuality(app, o, o.qualityGiven);
+        cli::finishLens(o, o.lensGiven);
+        o.lens = toLens(o.lensGiven);
+        o.quality = toQuality(o.qualityGiven);
         bool autoFocus = false;
         if (!parseFocus(o.focus, o.lens, autoFocus)) {
             spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);
             return kExitUsage;
         }
+        // --near and --far are checked at the starting focus (2 m with auto or inf), where run()
+        // takes their ratios to the focus from.
+        const double startM = std::isfinite(o.lens.focusM) ? o.lens.focusM : 2.0;
+        const LiveControls defaults;
+        o.lens.nearLimitM = o.nearM.value_or(defaults.nearRatio * startM);
+        o.lens.farLimitM = o.farM.value_or(defaults.farRatio * startM);
         // The command line is checked strictly, like defocus's; keys later clamp with a warning.
         if (const auto status = cli::checkLensAndQuality(o.lens, o.quality, autoFocus))
             return *status;

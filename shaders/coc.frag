@@ -12,7 +12,11 @@
 // against 33.01 for the top-left pixel's CoC (the nearest-neighbour resize of the depth), 33.02
 // for the nearest pixel's and 32.91 for the mean.
 // The last row and column repeat on frames of odd size. HIGHLIGHTS (with highlightGain > 1, or
-// bokeh sprites): the variant that treats highlights pixel by pixel before the mean.
+// bokeh sprites): the variant that treats highlights pixel by pixel before the mean. SPRITES
+// (bokeh sprites, highlightThreshold > 0): a pixel's light above the threshold leaves the gather
+// for its sprite, and a pixel above white is blurred at its light's depth (lightDepth(),
+// highlights.glsl); compiled out of the other variants, where llvmpipe would run it for every
+// pixel.
 #include "common.glsl"
 #include "coc_params.glsl"
 #include "highlights.glsl"
@@ -34,10 +38,16 @@ layout(std430, binding = 2) readonly buffer SpriteCount {
 // the frame.
 vec4 pixel(ivec2 texel)
 {
-    const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
-    const vec3 color = blurColor(texelFetch(uColor, texel, 0).rgb, coc);
-    const bool drawn = highlightThreshold > 0.0 && spriteHeader[5] <= spriteHeader[4];
+    const vec3 raw = texelFetch(uColor, texel, 0).rgb;
+#ifdef SPRITES
+    const float coc = signedCoc(lightDepth(uColor, uDepth, texel, luminance(raw)));
+    const vec3 color = blurColor(raw, coc);
+    const bool drawn = spriteHeader[5] <= spriteHeader[4];
     return vec4(drawn ? color * spriteShare(color, coc, texel, textureSize(uColor, 0)) : color, coc);
+#else
+    const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
+    return vec4(blurColor(raw, coc), coc);
+#endif
 }
 
 // The CoC of the four with the smallest |CoC|.

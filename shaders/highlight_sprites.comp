@@ -44,8 +44,9 @@ void main()
     const ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(texel, textureSize(uDepth, 0))))
         return;
-    const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
-    const vec3 color = blurColor(texelFetch(uColor, texel, 0).rgb, coc);
+    const vec3 raw = texelFetch(uColor, texel, 0).rgb;
+    const float coc = signedCoc(lightDepth(uColor, uDepth, texel, luminance(raw)));
+    const vec3 color = blurColor(raw, coc);
     const float share = spriteShare(color, coc, texel, textureSize(uDepth, 0));
     if (share >= 1.0)
         return;

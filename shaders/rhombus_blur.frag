@@ -24,13 +24,16 @@
 // comparing the taps' CoC orders them as depth would, without a depth fetch per tap.
 //
 // Bleeding: a tap nearer than the centre and sharper than it is weighted by its blurriness as in
-// the paper (bleedingBias/bleedingMult). NEAR_FIELD, "scatter as gather" (Jimenez 2014): each
-// line reaches as far as the largest foreground blur that can reach this pixel (tile maxima
-// dilated on the CPU); a nearer tap that is blurrier than the centre counts where its own radius
-// reaches the centre, with the coverage a scattered segment of its length would give, and lies
-// over the centre's own blur by that coverage. FIRST_PASS and NEAR_FIELD are compile-time
+// the paper (bleedingBias/bleedingMult); such a tap above white, or any nearer one whose own blur
+// does not reach the centre, counts by white's worth of its light (no ghost of a light in
+// front). NEAR_FIELD, "scatter as gather" (Jimenez 2014): each line reaches as far as the
+// largest foreground blur that can reach this pixel (tile maxima dilated on the CPU); a nearer
+// tap that is blurrier than the centre counts where its own radius reaches the centre, with the
+// coverage a scattered segment of its length would give, and lies over the centre's own blur by
+// that coverage. FIRST_PASS and NEAR_FIELD are compile-time
 // variants: llvmpipe pays for every instruction of a branch on a uniform. FUSED (second pass
 // only) writes the composite (A + 2B) / 3 itself, to one target: the output.
+#include "common.glsl"
 
 layout(location = 0) out vec4 outFirst;
 #ifndef FUSED
@@ -109,6 +112,7 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
     const float step = max(baseStep, extent / float(MAX_TAPS));
     const float length = extent / step;       // in steps
     const float ownLength = radius / step;    // the centre's own blur, in steps
+    const float halfPerStep = 0.5 / step;     // a CoC diameter to a radius in steps
     const int taps = int(ceil(length - 0.5)); // pieces k >= 1 that start inside the segment
     // Spread taps leave the lattice and are filtered; the switch fades over the first quarter
     // of a step so that the output stays continuous in the CoC.
@@ -142,8 +146,20 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
         // around its threshold instead of switched: depth noise at the threshold would make the
         // pixel flicker (a tap may carry most of a short line's weight).
         const float rule = nearer ? clamp(tapBlur * bleedingMult, 0.0, 1.0) : 1.0;
-        float weight = mix(1.0, rule, clamp((centerBlur - tapBlur - bleedingBias) / bleedingRamp + 0.5, 0.0, 1.0));
-        weight *= clamp(ownLength - float(k) + 0.5, 0.0, 1.0);
+        const float bleeding = clamp((centerBlur - tapBlur - bleedingBias) / bleedingRamp + 0.5, 0.0, 1.0);
+        float weight = mix(1.0, rule, bleeding);
+        // A nearer tap whose own blur does not reach this pixel hides what lies behind it here
+        // rather than lighting it: above white, it counts by a share of its weight inversely
+        // proportional to its luminance, white's worth of it (weights, not colours, change, so
+        // the output stays a mean of the frame's colours). Otherwise a light in front of a
+        // blurred background was drawn a second time, as a pale hexagon as large as the
+        // background's blur: in focus or just in front of it (the bleeding rule's fallback
+        // weight, or its full weight below the rule's bias), or at the edge of its own bokeh.
+        const float ownPiece = clamp(ownLength - float(k) + 0.5, 0.0, 1.0);
+        const float tapPiece = clamp(abs(tap.a) * halfPerStep - float(k) + 0.5, 0.0, 1.0);
+        const float unreached = nearer ? clamp(1.0 - tapPiece / max(ownPiece, 1e-6), 0.0, 1.0) : 0.0;
+        weight *= mix(1.0, 1.0 / max(luminance(tap.rgb), 1.0), max(unreached, nearer ? bleeding : 0.0));
+        weight *= ownPiece;
 #ifdef NEAR_FIELD
         // Foreground that reaches: soft over the last half pixel of its radius; a segment of
         // length tapRadius scattered from the tap puts step / tapRadius of it on this pixel.

@@ -27,8 +27,8 @@ layout(binding = 1) uniform sampler2D uColor;
 const int kEdges = 8;
 const float kHistogramEdges[kEdges] = float[](0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0);
 
-// scene_measurement.glsl's layout (the luminance sum: the bokeh sprites compare a pixel with its
-// tile's mean, highlights.glsl).
+// scene_measurement.glsl's layout (the luminance sum: the bokeh sprites compare a pixel with the
+// mean of the 3x3 tiles around it, highlights.glsl).
 layout(std430, binding = 0) writeonly buffer Measurement {
     uint words[];
 };

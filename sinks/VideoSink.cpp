@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
+#include <mutex>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -38,8 +41,9 @@ struct Codec {
 };
 
 // avc1 is H.264 through FFmpeg's libx264 (Debian's FFmpeg has it); FFV1 is FFmpeg's lossless
-// intra codec; VP90 is libvpx's VP9 (OpenCV's FFmpeg wrapper prints that it maps the tag for
-// WebM, then writes VP9: a line on stderr it prints itself).
+// intra codec; VP90 is libvpx's VP9. For WebM, OpenCV's FFmpeg wrapper prints that the tag "is not
+// supported with codec id 167" and writes VP9 all the same; no FourCC avoids it (WebM's muxer
+// lists VP9 under tag 0), so withoutTagNotice drops that line.
 const std::vector<Codec> kCodecs{{"h264", "avc1"}, {"mp4v", "mp4v"}, {"ffv1", "FFV1"}, {"vp9", "VP90"}, {"mjpg", "MJPG"}};
 
 // The container's default first, then what it falls back to when that encoder is missing.
@@ -70,6 +74,51 @@ std::string joined(const std::vector<std::string>& items)
     for (const std::string& item : items)
         out += (out.empty() ? "" : ", ") + item;
     return out;
+}
+
+/// The line OpenCV's FFmpeg wrapper writes with fprintf(stderr) when a container lists the codec
+/// under another tag than the FourCC asked for; it goes on with the container's tag.
+bool isTagNotice(const char* line)
+{
+    return std::strncmp(line, "OpenCV: FFMPEG: tag 0x", 22) == 0 && std::strstr(line, "is not supported with codec id");
+}
+
+/// Runs `open` with file descriptor 2 sent to a temporary file, then copies what was caught to
+/// standard error but OpenCV's tag notice (isTagNotice), so that a clean run prints only the
+/// program's own lines. What other threads write to standard error meanwhile is passed on late,
+/// not lost. Without a temporary file or a spare descriptor it just runs `open`.
+template <class Open>
+bool withoutTagNotice(Open&& open)
+{
+    static std::mutex mutex; // one redirection at a time (--batch --in-flight opens in threads)
+    const std::lock_guard lock(mutex);
+    std::fflush(stderr);
+    std::FILE* caught = std::tmpfile();
+    const int saved = caught ? ::dup(STDERR_FILENO) : -1;
+    if (saved < 0 || ::dup2(::fileno(caught), STDERR_FILENO) < 0) {
+        if (saved >= 0)
+            ::close(saved);
+        if (caught)
+            std::fclose(caught);
+        return open();
+    }
+    struct Restore {
+        int saved;
+        std::FILE* caught;
+        ~Restore()
+        {
+            std::fflush(stderr);
+            ::dup2(saved, STDERR_FILENO);
+            ::close(saved);
+            std::rewind(caught);
+            char line[4096];
+            while (std::fgets(line, sizeof line, caught))
+                if (!isTagNotice(line))
+                    std::fputs(line, stderr);
+            std::fclose(caught);
+        }
+    } restore{saved, caught};
+    return open();
 }
 
 } // namespace
@@ -141,9 +190,10 @@ bool VideoSink::openWriter(cv::VideoWriter& writer, const std::string& fourcc, c
     // noise to the log.
     const int api = cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY;
     try {
-        return writer.open(partial_.string(), api,
-                           cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]),
-                           fps_, size, true);
+        return withoutTagNotice([&] {
+            return writer.open(partial_.string(), api,
+                               cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]), fps_, size, true);
+        });
     } catch (const cv::Exception& e) {
         spdlog::debug("video '{}': {} failed to open: {}", file_.string(), fourcc, e.err);
         return false;

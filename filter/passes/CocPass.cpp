@@ -12,8 +12,11 @@ namespace defocus {
 
 CocPass::CocPass()
     : program_("fullscreen.vert", "coc.frag", kName),
+      spritesProgram_("fullscreen.vert", "coc.frag", "coc sprites", {"SPRITES 1"}),
       halfProgram_("fullscreen.vert", "coc.frag", "coc half size", {"HALF_SIZE 1"}),
       halfHighlightsProgram_("fullscreen.vert", "coc.frag", "coc half size highlights", {"HALF_SIZE 1", "HIGHLIGHTS 1"}),
+      halfSpritesProgram_("fullscreen.vert", "coc.frag", "coc half size sprites",
+                          {"HALF_SIZE 1", "HIGHLIGHTS 1", "SPRITES 1"}),
       uniforms_(sizeof(Uniforms), "coc params"),
       noSprites_(8 * sizeof(std::uint32_t), "coc: no sprites"),
       nearest_(GL_NEAREST, "coc nearest"),
@@ -60,8 +63,11 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocC
     uniforms_.bind(0);
     target.bindForDraw();
     // Highlights are treated pixel by pixel: at half size, four fetches instead of one mean.
-    const bool highlights = highlightGain > 1.0f || highlightThreshold > 0.0f;
-    (!halfSize ? program_ : highlights ? halfHighlightsProgram_ : halfProgram_).use();
+    const bool withSprites = highlightThreshold > 0.0f;
+    const bool highlights = highlightGain > 1.0f || withSprites;
+    const gl::Program& full = withSprites ? spritesProgram_ : program_;
+    const gl::Program& half = withSprites ? halfSpritesProgram_ : highlights ? halfHighlightsProgram_ : halfProgram_;
+    (halfSize ? half : full).use();
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
     bindTexture(2, color.id(), linear_.id());

@@ -42,7 +42,10 @@ public:
                              float highlightThreshold = 0.0f);
 
 private:
-    gl::Program program_, halfProgram_, halfHighlightsProgram_;
+    /// SPRITES: the variants for frames with bokeh sprites (highlightThreshold > 0): a pixel's
+    /// sprite share and its light's depth (coc.frag), compiled out of the others, since llvmpipe
+    /// runs a branch's instructions even where no pixel takes it.
+    gl::Program program_, spritesProgram_, halfProgram_, halfHighlightsProgram_, halfSpritesProgram_;
     gl::UniformBuffer uniforms_;
     gl::StorageBuffer noSprites_; ///< bound for the sprite count where there are no sprites
     gl::Sampler nearest_;
