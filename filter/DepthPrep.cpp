@@ -100,6 +100,38 @@ PreparedDepth prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM)
     return out;
 }
 
+std::size_t putLightEdgesAtTheirLightsDepth(const cv::Mat& colorLinear, cv::Mat& metres)
+{
+    CV_Assert(colorLinear.type() == CV_32FC3 && metres.type() == CV_32FC1 && colorLinear.size() == metres.size());
+    const auto luminance = [](const cv::Vec3f& bgr) { return 0.0722f * bgr[0] + 0.7152f * bgr[1] + 0.2126f * bgr[2]; };
+    // Decided on the depth as it was: a changed pixel must not move its neighbours.
+    const cv::Mat before = metres.clone();
+    const int last = colorLinear.rows - 1, lastX = colorLinear.cols - 1;
+    std::size_t changed = 0;
+    for (int y = 0; y <= last; ++y) {
+        const auto* row = colorLinear.ptr<cv::Vec3f>(y);
+        for (int x = 0; x <= lastX; ++x) {
+            const float brightness = luminance(row[x]);
+            if (!(brightness > 1.0f))
+                continue;
+            float brightest = brightness;
+            cv::Point at{x, y};
+            for (int qy = std::max(y - 1, 0); qy <= std::min(y + 1, last); ++qy)
+                for (int qx = std::max(x - 1, 0); qx <= std::min(x + 1, lastX); ++qx)
+                    if (const float b = luminance(colorLinear.at<cv::Vec3f>(qy, qx)); b > brightest) {
+                        brightest = b;
+                        at = {qx, qy};
+                    }
+            const float z = before.at<float>(at);
+            if (z < before.at<float>(y, x)) {
+                metres.at<float>(y, x) = z;
+                ++changed;
+            }
+        }
+    }
+    return changed;
+}
+
 float centreDepth(const cv::Mat& depth, double windowFraction, float fallbackM)
 {
     if (depth.empty())

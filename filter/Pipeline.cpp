@@ -276,6 +276,10 @@ void Pipeline::Impl::prepareDepthAndPlan()
     // Depth: colour-sized, holes filled. With no depth at all, everything sits on the focus plane.
     auto start = Clock::now();
     prepared = prepareDepth(depthInput, size, fallbackDepth);
+    // The rhombi's bokeh sprites take the light above white out of the gather; its edges go with
+    // it (float frames only: 8-bit ones have nothing above white).
+    if (color.type() == CV_32FC3 && quality.kernel == HexagonKernel::RhombiSum && quality.highlightSprites)
+        putLightEdgesAtTheirLightsDepth(color, prepared.metres);
     timings.depthPrepMs = msSince(start);
     depthPrepared = true;
 

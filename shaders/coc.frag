@@ -14,8 +14,7 @@
 // The last row and column repeat on frames of odd size. HIGHLIGHTS (with highlightGain > 1, or
 // bokeh sprites): the variant that treats highlights pixel by pixel before the mean. SPRITES
 // (bokeh sprites, highlightThreshold > 0): a pixel's light above the threshold leaves the gather
-// for its sprite, and a pixel above white is blurred at its light's depth (lightDepth(),
-// highlights.glsl); compiled out of the other variants, where llvmpipe would run it for every
+// for its sprite; compiled out of the other variants, where llvmpipe would run it for every
 // pixel.
 #include "common.glsl"
 #include "coc_params.glsl"
@@ -40,7 +39,7 @@ vec4 pixel(ivec2 texel)
 {
     const vec3 raw = texelFetch(uColor, texel, 0).rgb;
 #ifdef SPRITES
-    const float coc = signedCoc(lightDepth(uColor, uDepth, texel, luminance(raw)));
+    const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
     const vec3 color = blurColor(raw, coc);
     const bool drawn = spriteHeader[5] <= spriteHeader[4];
     return vec4(drawn ? color * spriteShare(color, coc, texel, textureSize(uColor, 0)) : color, coc);

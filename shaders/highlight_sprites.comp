@@ -45,7 +45,7 @@ void main()
     if (any(greaterThanEqual(texel, textureSize(uDepth, 0))))
         return;
     const vec3 raw = texelFetch(uColor, texel, 0).rgb;
-    const float coc = signedCoc(lightDepth(uColor, uDepth, texel, luminance(raw)));
+    const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
     const vec3 color = blurColor(raw, coc);
     const float share = spriteShare(color, coc, texel, textureSize(uDepth, 0));
     if (share >= 1.0)

@@ -21,33 +21,6 @@ vec3 blurColor(vec3 color, float coc)
     return sanitizeColor(recoverHighlight(color, coc), largestColor);
 }
 
-// The depth a pixel above white is blurred at: that of the brightest pixel of its 3x3
-// neighbourhood when that one is brighter and nearer, else its own. A light's antialiased edge
-// mixes the light with what lies behind it, and a renderer's depth (or a sensor's) gives such a
-// pixel one depth, often the background's: its share of the light then took the background's
-// blur, a pale hexagon as large as that blur around a light in front of it (overlapping-lights
-// in the corpus: 24.68 -> 26.94 dB, balanced). Nearer only: a light beside a nearer occluder
-// whose antialiased edge is above white (a railing's bar in front of it) keeps its own depth.
-float lightDepth(sampler2D colorTexture, sampler2D depthTexture, ivec2 texel, float brightness)
-{
-    float depth = texelFetch(depthTexture, texel, 0).r;
-    if (brightness <= 1.0)
-        return depth;
-    const ivec2 last = textureSize(depthTexture, 0) - 1;
-    float brightest = brightness;
-    ivec2 at = texel;
-    for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-            const ivec2 q = clamp(texel + ivec2(dx, dy), ivec2(0), last);
-            const float b = luminance(texelFetch(colorTexture, q, 0).rgb);
-            if (b > brightest) {
-                brightest = b;
-                at = q;
-            }
-        }
-    return min(depth, texelFetch(depthTexture, at, 0).r);
-}
-
 // The scene analysis' measurement of the frame (scene_measurement.glsl).
 layout(std430, binding = 1) readonly buffer SceneMeasurement {
     uint measurement[];
