@@ -14,6 +14,9 @@ CocPass::CocPass()
     : program_("fullscreen.vert", "coc.frag", kName),
       halfProgram_("fullscreen.vert", "coc.frag", "coc half size", {"HALF_SIZE 1"}),
       halfHighlightsProgram_("fullscreen.vert", "coc.frag", "coc half size highlights", {"HALF_SIZE 1", "HIGHLIGHTS 1"}),
+      quarterProgram_("fullscreen.vert", "coc.frag", "coc quarter size", {"QUARTER_SIZE 1"}),
+      quarterHighlightsProgram_("fullscreen.vert", "coc.frag", "coc quarter size highlights",
+                                {"QUARTER_SIZE 1", "HIGHLIGHTS 1"}),
       uniforms_(sizeof(Uniforms), "coc params"),
       noSprites_(8 * sizeof(std::uint32_t), "coc: no sprites"),
       nearest_(GL_NEAREST, "coc nearest"),
@@ -48,7 +51,7 @@ CocPass::Uniforms CocPass::uniforms(const CocCoefficients& k, bool halfTarget, f
 }
 
 void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-                  const gl::Framebuffer& target, float highlightGain, bool halfSize, float highlightThreshold,
+                  const gl::Framebuffer& target, float highlightGain, int sizeShift, float highlightThreshold,
                   const gl::StorageBuffer* measurement, const gl::StorageBuffer* sprites)
 {
     assert(highlightThreshold <= 0.0f || (measurement && sprites));
@@ -59,9 +62,13 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocC
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();
+    assert(sizeShift >= 0 && sizeShift <= 2);
     // Highlights are treated pixel by pixel: at half size, four fetches instead of one mean.
     const bool highlights = highlightGain > 1.0f || highlightThreshold > 0.0f;
-    (!halfSize ? program_ : highlights ? halfHighlightsProgram_ : halfProgram_).use();
+    (sizeShift == 0   ? program_
+     : sizeShift == 1 ? (highlights ? halfHighlightsProgram_ : halfProgram_)
+                      : (highlights ? quarterHighlightsProgram_ : quarterProgram_))
+        .use();
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
     bindTexture(2, color.id(), linear_.id());
