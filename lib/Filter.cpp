@@ -13,7 +13,9 @@
 #include "filter/Autofocus.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Pipeline.hpp"
+#include "filter/SceneAnalysis.hpp"
 #include "filter/Settings.hpp"
+#include "filter/Views.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
 #include "filter/methods/Presets.hpp"
@@ -161,6 +163,52 @@ std::vector<std::string> check(Settings& settings, bool clamp)
     return issues;
 }
 
+Quality resolve(const Quality& quality)
+{
+    const QualitySettings q = toQuality(quality);
+    Quality out = quality;
+    out.samples = q.samples;
+    out.hexagon = q.kernel == HexagonKernel::McIntoshMin ? Quality::Hexagon::McIntosh : Quality::Hexagon::Rhombi;
+    out.precision = q.targetFormat == TargetFormat::Rgba32F ? Quality::Precision::F32 : Quality::Precision::F16;
+    out.resolution = q.resolution == Resolution::Half ? Quality::Resolution::Half : Quality::Resolution::Full;
+    out.nearField = q.nearField;
+    return out;
+}
+
+std::vector<EglDevice> eglDevices()
+{
+    std::vector<EglDevice> out;
+    for (const auto& d : gl::EglContext::devices())
+        out.push_back({d.index, d.software, d.drmFile, d.cudaId});
+    return out;
+}
+
+namespace {
+
+RendererInfo toRendererInfo(const gl::ContextInfo& info)
+{
+    return {info.platform,  info.device,     info.eglVendor, info.eglVersion,
+            info.glVendor,  info.glRenderer, info.glVersion, info.timerQueries};
+}
+
+gl::ContextOptions toContextOptions(const ContextOptions& options)
+{
+    gl::ContextOptions out;
+    out.device = options.eglDevice;
+    return out;
+}
+
+} // namespace
+
+RendererInfo probeRenderer(const ContextOptions& context)
+{
+    try {
+        return toRendererInfo(gl::EglContext::create(toContextOptions(context)).info());
+    } catch (const gl::ContextError& error) {
+        throw GlError(error.what());
+    }
+}
+
 std::string version()
 {
     return DEFOCUS_VERSION;
@@ -178,8 +226,14 @@ struct Filter::Impl {
     double previousTimestamp = 0.0;
     std::size_t frames = 0;
     FrameReport report;
+    /// The last process()'s frame and lens, for contactSheet() to process it again.
+    std::optional<Frame> lastFrame;
+    LensSettings lastLens;
 
     explicit Impl(gl::EglContext made) : context(std::move(made)) {}
+
+    /// report from the pipeline's last frame (frame number `frames`).
+    void fillReport();
 
     void bind()
     {
@@ -212,13 +266,15 @@ struct Filter::Impl {
     }
 };
 
-Filter::Filter(const Settings& settings)
+Filter::Filter(const Settings& settings) : Filter(settings, ContextOptions{}) {}
+
+Filter::Filter(const Settings& settings, const ContextOptions& context)
 {
     Settings checked = settings;
     if (const auto issues = check(checked); !issues.empty())
         throw SettingsError(issues.front());
     try {
-        impl_ = std::make_unique<Impl>(gl::EglContext::create());
+        impl_ = std::make_unique<Impl>(gl::EglContext::create(toContextOptions(context)));
         impl_->pipeline.emplace();
     } catch (const gl::ContextError& error) {
         throw GlError(error.what());
@@ -322,11 +378,20 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     const Encoding encoding =
         p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
     cv::Mat out = p.pipeline->run(frame, lens, p.quality, toView(p.settings.view), encoding);
+    p.lastFrame = std::move(frame);
+    p.lastLens = lens;
+    p.fillReport();
+    ++p.frames;
+    return out;
+}
 
+void Filter::Impl::fillReport()
+{
+    Impl& p = *this;
     const FrameTimings& t = p.pipeline->timings();
     FrameReport& r = p.report;
-    r.index = p.frames++;
-    r.focusM = lens.focusM;
+    r.index = p.frames;
+    r.focusM = p.lastLens.focusM;
     r.timings.totalMs = t.totalMs;
     r.timings.depthPrepMs = t.depthPrepMs;
     r.timings.analysisMs = t.analysisMs;
@@ -348,7 +413,6 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     r.plan.nearField = plan.nearField;
     r.plan.highlightSprites = plan.highlightSprites;
     r.plan.explain = plan.explain(analysis);
-    return out;
 }
 
 const FrameReport& Filter::lastFrame() const
@@ -356,10 +420,44 @@ const FrameReport& Filter::lastFrame() const
     return impl_->report;
 }
 
+std::vector<Timings::Pass> Filter::finishGpuTimings()
+{
+    impl_->bind();
+    std::vector<Timings::Pass> out;
+    for (const auto& pass : impl_->pipeline->drainGpuTimes())
+        out.push_back({pass.name, pass.ms});
+    return out;
+}
+
+cv::Mat Filter::contactSheet()
+{
+    Impl& p = *impl_;
+    if (!p.lastFrame)
+        throw InputError("contact sheet: no frame processed yet");
+    p.bind();
+    Pipeline& pipeline = *p.pipeline;
+    std::vector<std::pair<std::string, cv::Mat>> tiles;
+    int number = 1;
+    for (const View v : kAllViews)
+        tiles.emplace_back(fmt::format("{} {}", number++, viewName(v)), pipeline.read(v, Encoding::Srgb8));
+    tiles.emplace_back("plan: blur tiles outlined, copied dimmed, near field blue",
+                       drawTileMap(tiles.front().second, pipeline.plan(), pipeline.analysis()));
+    cv::Mat sheet = defocus::contactSheet(tiles);
+    // Processed again so that the timings are a plain frame's, not the views' reads.
+    const Encoding encoding =
+        p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
+    pipeline.run(*p.lastFrame, p.lastLens, p.quality, toView(p.settings.view), encoding);
+    --p.frames;
+    p.fillReport();
+    ++p.frames;
+    return sheet;
+}
+
 void Filter::reset()
 {
     Impl& p = *impl_;
     p.frames = 0;
+    p.lastFrame.reset();
     p.focusChosen = false;
     p.previousTimestamp = 0.0;
     p.report = {};
@@ -378,6 +476,11 @@ void Filter::release()
 std::string Filter::renderer() const
 {
     return impl_->context.info().glRenderer;
+}
+
+RendererInfo Filter::rendererInfo() const
+{
+    return toRendererInfo(impl_->context.info());
 }
 
 } // namespace defocus

@@ -11,6 +11,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "defocus/Filter.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
 #include "sources/FrameSource.hpp"
@@ -128,7 +129,7 @@ void requestStop(int signal)
 int statusFor(const std::exception& error)
 {
     if (dynamic_cast<const gl::ContextError*>(&error) || dynamic_cast<const gl::ShaderError*>(&error) ||
-        dynamic_cast<const DeviceBusy*>(&error))
+        dynamic_cast<const GlError*>(&error) || dynamic_cast<const DeviceBusy*>(&error))
         return kExitUnavailable;
     return kExitBadInput;
 }

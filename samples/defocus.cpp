@@ -2,14 +2,19 @@
 //   defocus data/tum_fr1_rpy -o out/tum.mp4 --focus 1.2 --f-number 1.4
 //   defocus photo.png --depth depth.png --depth-scale 1000 -o out.png --view coc
 //   defocus --info
-// The flow: parse the command line (declareOptions, finishOptions) -> runClip(options, gl), which
-// opens the input and output and hands them to processClip; the GL context and pipeline (GlSession)
-// are opened once and can serve several clips. Results go to standard output, diagnostics to
-// standard error; the exit statuses are ExitStatus.hpp's.
+// The flow: parse the command line (declareOptions, finishOptions) -> runClip(options, filter),
+// which opens the input and output and hands them to processClip. The settings and the filtering
+// go through the library's public API (defocus::Settings, defocus::Filter, include/defocus/): one
+// Filter, its GL context and shaders, is made once and serves several clips (--batch). The
+// command line's parsing (CLI11), // the sources and the sinks are the tree's own, and so is the focus control (FocusSchedule, over
+// the pipeline's Autofocus) and --demo's synthetic source (which takes the pipeline's lens type). Results go to standard output, diagnostics to standard error;
+// the exit statuses are ExitStatus.hpp's.
 #include <algorithm>
 #include <csignal>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
+#include <limits>
 #include <map>
 #include <string>
 
@@ -20,14 +25,8 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
-#include "filter/ColorSpace.hpp"
-#include "filter/DepthPrep.hpp"
-#include "filter/methods/Presets.hpp"
-#include "filter/Pipeline.hpp"
-#include "filter/Settings.hpp"
-#include "filter/Views.hpp"
-#include "filter/gl/EglContext.hpp"
-#include "filter/gl/Program.hpp"
+#include "defocus/Filter.hpp"
+#include "defocus/Settings.hpp"
 #include "samples/Batch.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
@@ -51,12 +50,14 @@ struct Options {
     std::string depth;
     std::optional<double> depthScale;
     std::string focus = "auto";
-    LensSettings lens;
-    QualitySettings quality;
-    std::string qualityPreset = std::string(kDefaultPreset);
+    /// The lens and quality (every field resolved by finishOptions), the view; the output's
+    /// encoding is the sink's, the focus is set frame by frame.
+    Settings settings;
+    bool nearField = false;            ///< --near-field / --no-near-field, when given
+    std::string qualityPreset = "balanced";
     std::string model = "thin-lens";
     std::string fov = "image-distance";
-    std::string precision = "16f";
+    std::string precision = "16f";     ///< as given, then as resolved (the report's words)
     std::string resolution = "full";
     std::string kernel = "rhombi";
     std::string view = "composite";
@@ -80,7 +81,6 @@ struct Options {
     bool overwrite = false;   ///< -y: replace outputs that exist
     std::string codec;        ///< --codec, "" = the container's default
     std::string imageFormat = "png"; ///< --image-format of a folder output
-    bool alwaysOn = false;
     // Many clips (samples/Batch.hpp) and the GPU.
     std::string batch;         ///< --batch MANIFEST
     std::string shard;         ///< --shard I/N, "" = the Slurm array task's, else 0/1
@@ -91,23 +91,42 @@ struct Options {
     std::string report;        ///< --report FILE.json of a single run
 };
 
-gl::ContextOptions contextOptions(const Options& options)
+ContextOptions contextOptions(const Options& options)
 {
-    gl::ContextOptions context;
-    context.device = options.eglDevice;
+    ContextOptions context;
+    context.eglDevice = options.eglDevice;
     return context;
+}
+
+/// --view's names, in the order of Settings::View.
+constexpr const char* kViewNames[] = {"input", "horizontal", "diagonal-a", "diagonal-b", "composite", "depth", "coc"};
+
+/// --demo's synthetic source (sources/, the tree's own) takes the pipeline's lens type.
+LensSettings demoLens(const Lens& lens)
+{
+    LensSettings out;
+    out.model = lens.cocModel == Lens::Model::FocalRange ? CocModel::FocalRange : CocModel::ThinLens;
+    out.focalLengthMm = lens.focalLengthMm;
+    out.fNumber = lens.fNumber;
+    out.focusM = lens.focusM;
+    out.sensorWidthMm = lens.sensorWidthMm;
+    out.fieldOfView = lens.fovFrom == Lens::FovFrom::FocalLength ? FieldOfView::FocalLength : FieldOfView::ImageDistance;
+    out.maxCocPx = lens.maxCocPx;
+    out.bladeRotationDeg = lens.bladeRotationDeg;
+    out.nearLimitM = lens.nearM;
+    out.farLimitM = lens.farM;
+    return out;
 }
 
 int printInfo(const Options& options)
 {
-    for (const auto& d : gl::EglContext::devices())
+    for (const auto& d : eglDevices())
         fmt::print("EGL device {}: {}{}{}\n", d.index, d.software ? "software" : "hardware",
                    d.drmFile.empty() ? "" : ", " + d.drmFile, d.cudaId ? fmt::format(", CUDA device {}", *d.cudaId) : "");
-    const auto context = gl::EglContext::create(contextOptions(options));
-    const auto& info = context.info();
+    const RendererInfo info = probeRenderer(contextOptions(options));
     fmt::print("EGL platform: {}{}\nEGL vendor:   {}\nEGL version:  {}\nGL vendor:    {}\nGL renderer:  {}\n"
                "GL version:   {}\nGPU timers:   {}\n",
-               info.platform, info.device >= 0 ? fmt::format(" (EGL device {})", info.device) : "", info.eglVendor,
+               info.platform, info.eglDevice >= 0 ? fmt::format(" (EGL device {})", info.eglDevice) : "", info.eglVendor,
                info.eglVersion, info.glVendor, info.glRenderer, info.glVersion, info.timerQueries ? "yes" : "no");
     return kExitDone;
 }
@@ -135,8 +154,10 @@ std::string summarise(std::size_t in, std::size_t out, const std::map<std::strin
 /// Per-frame timings for --timings, and their p50/p95/max summary.
 class TimingLog {
 public:
-    void frame(const FrameTimings& t, std::size_t index)
+    /// Frame `index` of the clip, the filter's frame `filterIndex` (Timings::gpuFrame counts those).
+    void frame(const Timings& t, std::size_t index, std::size_t filterIndex)
     {
+        filterIndex_.push_back(filterIndex);
         frames_.push_back({{"index", index},
                            {"total_ms", t.totalMs},
                            {"depth_prep_ms", t.depthPrepMs},
@@ -148,13 +169,14 @@ public:
         if (!t.gpu.empty())
             gpu(t.gpu, t.gpuFrame);
     }
-    /// GPU times arrive one frame late; they go to the frame they measured.
-    void gpu(const std::vector<PassTime>& passes, std::size_t index)
+    /// GPU times arrive one frame late; they go to the frame they measured, the filter's frame
+    /// `filterIndex`.
+    void gpu(const std::vector<Timings::Pass>& passes, std::size_t filterIndex)
     {
-        for (auto& f : frames_)
-            if (f["index"] == index)
+        for (std::size_t i = 0; i < frames_.size(); ++i)
+            if (filterIndex_[i] == filterIndex)
                 for (const auto& pass : passes)
-                    f["gpu_ms"][pass.name] = pass.ms;
+                    frames_[i]["gpu_ms"][pass.name] = pass.ms;
     }
     /// p50/p95/max of each timing and each pass over the frames so far.
     nlohmann::json summary() const
@@ -192,6 +214,7 @@ public:
 
 private:
     std::vector<nlohmann::json> frames_;
+    std::vector<std::size_t> filterIndex_; ///< the filter's frame number of each of frames_
 };
 
 /// --demo: a synthetic scene's shot (docs/synthetic.md) through the command line's lens; with
@@ -200,27 +223,20 @@ std::unique_ptr<SyntheticSource> openDemo(const Options& options)
 {
     SyntheticSettings settings;
     settings.frames = options.frames.value_or(60);
-    settings.lens = options.lens;
+    settings.lens = demoLens(options.settings.lens);
     settings.focusPull = options.focus == "auto";
     return std::make_unique<SyntheticSource>(syntheticScene(options.demoScene), settings);
 }
 
-/// What several clips can share: the GL context and the pipeline with its compiled shaders.
-struct GlSession {
-    explicit GlSession(gl::EglContext glContext) : context(std::move(glContext)) {}
-    gl::EglContext context; ///< first: the pipeline's GL objects live in it
-    Pipeline pipeline;
-};
-
 /// What a clip's report says of it (--report, --batch): frames, the settings as resolved, the
 /// renderer, and the timings' p50/p95/max.
-void fillReport(nlohmann::json& r, const Options& options, const LensSettings& lens, const gl::ContextInfo& info,
+void fillReport(nlohmann::json& r, const Options& options, const Lens& lens, const RendererInfo& info,
                 std::size_t framesIn, const FrameSink& sink, const TimingLog& timingLog)
 {
     r["frames_in"] = framesIn;
     r["frames_out"] = sink.framesWritten();
     r["output"] = sink.describe();
-    r["renderer"] = {{"platform", info.platform},     {"egl_device", info.device}, {"egl_vendor", info.eglVendor},
+    r["renderer"] = {{"platform", info.platform},     {"egl_device", info.eglDevice}, {"egl_vendor", info.eglVendor},
                      {"egl_version", info.eglVersion}, {"gl_vendor", info.glVendor}, {"gl_renderer", info.glRenderer},
                      {"gl_version", info.glVersion}};
     r["settings"] = {{"focus", options.focus},
@@ -228,21 +244,21 @@ void fillReport(nlohmann::json& r, const Options& options, const LensSettings& l
                      {"f_number", lens.fNumber},
                      {"focal_length_mm", lens.focalLengthMm},
                      {"sensor_width_mm", lens.sensorWidthMm},
-                     {"fov_from", fieldOfViewName(lens.fieldOfView)},
+                     {"fov_from", options.fov},
                      {"max_coc_px", lens.maxCocPx},
                      {"coc_model", options.model},
-                     {"near_m", lens.nearLimitM},
-                     {"far_m", lens.farLimitM},
+                     {"near_m", lens.nearM},
+                     {"far_m", lens.farM},
                      {"blade_rotation_deg", lens.bladeRotationDeg},
                      {"quality", options.qualityPreset},
-                     {"samples", options.quality.samples},
+                     {"samples", options.settings.quality.samples.value_or(0)},
                      {"hexagon", options.kernel},
                      {"precision", options.precision},
                      {"resolution", options.resolution},
-                     {"near_field", options.quality.nearField},
-                     {"highlight_sprites", options.quality.highlightSprites},
-                     {"highlight_gain", options.quality.highlightGain},
-                     {"adaptive", options.quality.adaptive},
+                     {"near_field", options.settings.quality.nearField.value_or(false)},
+                     {"highlight_sprites", options.settings.quality.highlightSprites},
+                     {"highlight_gain", options.settings.quality.highlightGain},
+                     {"adaptive", !options.settings.quality.alwaysOn},
                      {"view", options.view},
                      {"frames", options.frames ? nlohmann::json(*options.frames) : nlohmann::json()}};
     r["timings_ms"] = timingLog.summary();
@@ -251,20 +267,22 @@ void fillReport(nlohmann::json& r, const Options& options, const LensSettings& l
 /// The frames of one clip from `source` through the pipeline into `sink`; returns the exit status.
 /// Stops early at SIGINT/SIGTERM (the sink is finalised all the same) or at an error (the frames
 /// before it are kept).
-int processClip(const Options& options, FrameSource& source, SyntheticSource* demo, FrameSink& sink, GlSession& gl,
+int processClip(const Options& options, FrameSource& source, SyntheticSource* demo, FrameSink& sink, Filter& filter,
                 nlohmann::json* report)
 {
-    View view = View::Composite;
-    parseView(options.view, view); // validated by CLI11's check
-    Pipeline& pipeline = gl.pipeline;
-    const Encoding encoding = sink.encoding() == SinkEncoding::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
+    const Settings::Output output =
+        sink.encoding() == SinkEncoding::Linear32F ? Settings::Output::Linear32F : Settings::Output::Srgb8;
 
     std::optional<std::size_t> total = source.frameCount();
     if (options.frames)
         total = total ? std::min(*total, *options.frames) : *options.frames;
     Progress progress(total, !options.quiet);
 
-    LensSettings lens = options.lens;
+    Settings settings = options.settings;
+    settings.output = output;
+    Lens& lens = settings.lens; // its focus is set frame by frame
+    bool settingsGiven = false; // given to the filter with the first frame's focus
+    filter.reset();             // a new clip: frame 0 again
     std::optional<cv::Point2d> point;
     if (!options.focusPoint.empty())
         point = parsePoint(options.focusPoint); // checked by finishOptions
@@ -316,31 +334,29 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
                 if (framesIn == 1 && options.focus == "auto" && !options.quiet)
                     spdlog::info("focus: auto -> {:.2f} m (median depth around {} of {})", lens.focusM,
                                  point ? options.focusPoint : std::string("the centre"), frame->name);
-                if (const auto issues = validate(lens); !issues.empty())
+                if (const auto issues = check(settings); !issues.empty())
                     throw std::runtime_error(fmt::format("focus {:.3f} m at frame {}: {}", lens.focusM, frame->index,
-                                                         issues.front().message));
+                                                         issues.front()));
             }
             if (options.explain)
                 std::printf("frame %zu: focus %.4f m\n", frame->index, lens.focusM);
-            const cv::Mat image = pipeline.run(*frame, lens, options.quality, view, encoding);
+            if (!settingsGiven || lens.focusM != filter.settings().lens.focusM) {
+                filter.setSettings(settings); // checked: by finishOptions, or above
+                settingsGiven = true;
+            }
+            const cv::Mat image = filter.process(frame->color, frame->depth, frame->timestamp);
             if (!options.contactSheet.empty() && frame->index == options.contactFrame) {
-                std::vector<std::pair<std::string, cv::Mat>> tiles;
-                int number = 1;
-                for (const View v : kAllViews)
-                    tiles.emplace_back(fmt::format("{} {}", number++, viewName(v)), pipeline.read(v, Encoding::Srgb8));
-                tiles.emplace_back("plan: blur tiles outlined, copied dimmed, near field blue",
-                                   drawTileMap(tiles.front().second, pipeline.plan(), pipeline.analysis()));
-                writeImageAtomically(options.contactSheet, contactSheet(tiles));
-                pipeline.run(*frame, lens, options.quality, view, encoding); // keep timings of a plain frame
+                writeImageAtomically(options.contactSheet, filter.contactSheet());
                 sheetWritten = true;
             }
             sink.writeFrame(image, *frame);
             frameSize = image.size();
+            const FrameReport& done = filter.lastFrame();
             if (options.explain)
-                std::printf("frame %zu: %s\n", frame->index, pipeline.plan().explain(pipeline.analysis()).c_str());
+                std::printf("frame %zu: %s\n", frame->index, done.plan.explain.c_str());
 
-            const FrameTimings& t = pipeline.timings();
-            timingLog.frame(t, frame->index);
+            const Timings& t = done.timings;
+            timingLog.frame(t, frame->index, done.index);
             for (const auto& pass : t.gpu)
                 passMs[pass.name] += pass.ms;
             totalMs += t.totalMs;
@@ -363,13 +379,13 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         status = cli::statusFor(error);
     }
     progress.finish();
-    const auto lastGpu = pipeline.drainGpuTimes();
+    const auto lastGpu = filter.finishGpuTimings();
     if (framesIn > 0)
-        timingLog.gpu(lastGpu, framesIn - 1);
+        timingLog.gpu(lastGpu, filter.lastFrame().index);
     for (const auto& pass : lastGpu)
         passMs[pass.name] += pass.ms;
     if (!options.timings.empty() && framesIn > 0)
-        timingLog.write(options.timings, gl.context.info().glRenderer, frameSize);
+        timingLog.write(options.timings, filter.renderer(), frameSize);
     if (!options.contactSheet.empty() && !sheetWritten && status == kExitDone && !cli::stopRequested())
         spdlog::warn("--contact-frame {} is beyond the {} frames read: no contact sheet written to {}",
                      options.contactFrame, framesIn, options.contactSheet);
@@ -379,7 +395,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         status = cli::stopStatus();
     }
     if (report)
-        fillReport(*report, options, lens, gl.context.info(), framesIn, sink, timingLog);
+        fillReport(*report, options, lens, filter.rendererInfo(), framesIn, sink, timingLog);
     if (status == kExitDone && framesIn == 0) {
         spdlog::error("{} gave no frames", options.input);
         if (report)
@@ -393,10 +409,10 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     return status;
 }
 
-/// One clip, from INPUT (or --demo) to -o OUTPUT: opens the input, the GL session when `gl` holds
+/// One clip, from INPUT (or --demo) to -o OUTPUT: opens the input, the filter when `filter` holds
 /// none yet (so a bad input is reported before GL is needed), the output, and runs processClip.
 /// Throws for an input, output or GL that cannot be opened (cli::statusFor gives the status).
-int runClip(Options options, std::optional<GlSession>& gl, nlohmann::json* report = nullptr)
+int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* report = nullptr)
 {
     // Outputs besides the main one are checked before any frame is processed.
     if (!options.contactSheet.empty())
@@ -407,9 +423,10 @@ int runClip(Options options, std::optional<GlSession>& gl, nlohmann::json* repor
     std::unique_ptr<FrameSource> source;
     SyntheticSource* demo = nullptr;
     if (options.demo) {
-        // --demo renders its frames with GL, so the context comes first (the filter shares it).
-        if (!gl)
-            gl.emplace(gl::EglContext::create(contextOptions(options)));
+        // --demo renders its frames with GL in the context that is current on this thread: the
+        // filter's, so the filter comes first (Filter.hpp: its context stays current here).
+        if (!filter)
+            filter.emplace(Settings{}, contextOptions(options));
         auto synthetic = openDemo(options);
         demo = synthetic.get();
         source = std::move(synthetic);
@@ -423,8 +440,8 @@ int runClip(Options options, std::optional<GlSession>& gl, nlohmann::json* repor
         options.depthScaleUsed = options.depthScale.value_or(defaultDepthScale(sourceOptions));
     }
 
-    if (!gl)
-        gl.emplace(gl::EglContext::create(contextOptions(options)));
+    if (!filter)
+        filter.emplace(Settings{}, contextOptions(options));
 
     SinkOptions sinkOptions;
     sinkOptions.output = options.output;
@@ -441,8 +458,8 @@ int runClip(Options options, std::optional<GlSession>& gl, nlohmann::json* repor
         source = std::move(feed);
     }
     if (!options.quiet)
-        spdlog::info("{} -> {} on {}", source->describe(), options.output, gl->context.info().glRenderer);
-    const int status = processClip(options, *source, demo, *sink, *gl, report);
+        spdlog::info("{} -> {} on {}", source->describe(), options.output, filter->renderer());
+    const int status = processClip(options, *source, demo, *sink, *filter, report);
     if (newest && !options.quiet)
         spdlog::info("live: {} frames captured, {} dropped (the filter was slower than the camera)",
                      newest->captured(), newest->dropped());
@@ -469,23 +486,25 @@ void declareOptions(CLI::App& app, Options& o)
                    "--focus-point) of the first frame; 'track' = follow it frame by frame (the preview's "
                    "autofocus, --tau); keys such as 0s:1.2,2s:3.5 = a focus pull, eased in dioptres")
         ->capture_default_str();
-    app.add_option("--f-number", o.lens.fNumber, "Aperture as an f-number N (smaller = more blur), 0.7..64")
+    Lens& lens = o.settings.lens;
+    Quality& quality = o.settings.quality;
+    app.add_option("--f-number", lens.fNumber, "Aperture as an f-number N (smaller = more blur), 0.7..64")
         ->capture_default_str();
-    app.add_option("--focal-length", o.lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
-    app.add_option("--sensor-width", o.lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
+    app.add_option("--focal-length", lens.focalLengthMm, "Lens focal length, millimetres, 1..1200")->capture_default_str();
+    app.add_option("--sensor-width", lens.sensorWidthMm, "Sensor width the image spans, millimetres, 1..100")
         ->capture_default_str();
     app.add_option("--fov-from", o.fov, "Where the sensor width spans the image: image-distance (a real "
                    "camera, whose view narrows as it focuses closer) or focal-length (Blender, game engines)")
         ->check(CLI::IsMember({"image-distance", "focal-length"}))
         ->capture_default_str();
-    app.add_option("--max-coc", o.lens.maxCocPx, "Largest blur diameter, pixels, 0..512")->capture_default_str();
+    app.add_option("--max-coc", lens.maxCocPx, "Largest blur diameter, pixels, 0..512")->capture_default_str();
     app.add_option("--coc-model", o.model,
                    "thin-lens (physical) or focal-range (blur rises linearly from --focus to max at --near/--far)")
         ->check(CLI::IsMember({"thin-lens", "focal-range"}))
         ->capture_default_str();
-    app.add_option("--near", o.lens.nearLimitM, "focal-range model: metres where near blur reaches --max-coc")
+    app.add_option("--near", lens.nearM, "focal-range model: metres where near blur reaches --max-coc")
         ->capture_default_str();
-    app.add_option("--far", o.lens.farLimitM, "focal-range model: metres where far blur reaches --max-coc")
+    app.add_option("--far", lens.farM, "focal-range model: metres where far blur reaches --max-coc")
         ->capture_default_str();
     app.add_option("--quality", o.qualityPreset,
                    "Preset from the accuracy benchmark (docs/accuracy.md), all rhombi with their near field: fast (4 "
@@ -493,12 +512,12 @@ void declareOptions(CLI::App& app, Options& o)
                    "--precision, --resolution, --hexagon and --near-field override it")
         ->check(CLI::IsMember({"fast", "balanced", "high"}))
         ->capture_default_str();
-    app.add_option("--samples", o.quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
+    app.add_option("--samples", quality.samples, "Taps per directional blur, 2..64 [default: from --quality]");
     app.add_option("--hexagon", o.kernel,
                    "How the blurs make the hexagon: rhombi (three one-sided rhombi summed, keeps highlight energy) "
                    "or mcintosh (McIntosh et al. 2012, min of two) [default: from --quality]")
         ->check(CLI::IsMember({"rhombi", "mcintosh"}));
-    app.add_option("--blade-rotation", o.lens.bladeRotationDeg,
+    app.add_option("--blade-rotation", lens.bladeRotationDeg,
                    "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top (as Blender Cycles), 30 = flat top")
         ->capture_default_str();
     app.add_option("--precision", o.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
@@ -507,9 +526,7 @@ void declareOptions(CLI::App& app, Options& o)
                    "Size the blurs run at: full, or half (a quarter of the pixels; the output keeps the frame's "
                    "size and its in-focus pixels) [default: from --quality]")
         ->check(CLI::IsMember({"full", "half"}));
-    std::vector<std::string> views;
-    for (const View v : kAllViews)
-        views.emplace_back(viewName(v));
+    const std::vector<std::string> views(std::begin(kViewNames), std::end(kViewNames));
     app.add_option("--view", o.view, "What to write: " + fmt::format("{}", fmt::join(views, ", ")))
         ->check(CLI::IsMember(views))
         ->capture_default_str();
@@ -529,16 +546,16 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_option("--fps", o.fps, "Frame rate of a video output, Hz [default: the input's]")->check(CLI::PositiveNumber);
     app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
     app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
-    app.add_option("--highlight-gain", o.quality.highlightGain,
+    app.add_option("--highlight-gain", quality.highlightGain,
                    "8-bit input: scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off, 1..64)")
         ->capture_default_str();
-    app.add_flag("--near-field,!--no-near-field", o.quality.nearField,
+    app.add_flag("--near-field,!--no-near-field", o.nearField,
                  "Spread blurred foreground over what is behind it [default: from --quality]");
-    app.add_flag("--highlight-sprites,!--no-highlight-sprites", o.quality.highlightSprites,
+    app.add_flag("--highlight-sprites,!--no-highlight-sprites", quality.highlightSprites,
                  "Rhombi: lights brighter than white scatter as hexagons with exact edges (bokeh sprites) "
                  "[default: on]")
         ->capture_default_str();
-    app.add_flag("--always-on", o.alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
+    app.add_flag("--always-on", quality.alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
     app.add_flag("--info", o.info, "Print the EGL/OpenGL platform, vendor, renderer and version, then exit");
     app.add_flag("--demo", o.demo,
                  "No INPUT: render a synthetic clip (60 frames, a focus pull; --frames sets its length) and blur "
@@ -578,6 +595,21 @@ void declareOptions(CLI::App& app, Options& o)
         ->capture_default_str();
 }
 
+/// --focus as metres: a number (all of the text) or 'inf'/'infinity'; nullopt otherwise.
+std::optional<double> parseMetres(const std::string& text)
+{
+    if (text == "inf" || text == "infinity")
+        return std::numeric_limits<double>::infinity();
+    try {
+        std::size_t used = 0;
+        const double metres = std::stod(text, &used);
+        if (used == text.size())
+            return metres;
+    } catch (const std::logic_error&) {
+    }
+    return std::nullopt;
+}
+
 /// After parsing: presets under the explicit options, names to enums, ranges. nullopt: go on;
 /// otherwise the exit status (kExitUsage), with the reason logged.
 std::optional<int> finishOptions(const CLI::App& app, Options& o)
@@ -590,23 +622,29 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
         spdlog::error("INPUT and -o OUTPUT are required (see --help)");
         return kExitUsage;
     }
-    const QualitySettings fromPreset = presetSettings(o.qualityPreset);
-    if (app.count("--samples") == 0)
-        o.quality.samples = fromPreset.samples;
-    if (app.count("--precision") == 0)
-        o.precision = fromPreset.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
-    if (app.count("--hexagon") == 0)
-        o.kernel = std::string(kernelName(fromPreset.kernel));
-    if (app.count("--near-field") == 0)
-        o.quality.nearField = fromPreset.nearField;
-    if (app.count("--resolution") == 0)
-        o.resolution = std::string(resolutionName(fromPreset.resolution));
-    o.quality.adaptive = !o.alwaysOn;
-    o.lens.model = o.model == "focal-range" ? CocModel::FocalRange : CocModel::ThinLens;
-    parseFieldOfView(o.fov, o.lens.fieldOfView); // checked by CLI11
-    o.quality.targetFormat = o.precision == "32f" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
-    parseKernel(o.kernel, o.quality.kernel);
-    parseResolution(o.resolution, o.quality.resolution);
+    // The names are checked by CLI11; the flags given override the preset (defocus::resolve).
+    Quality& q = o.settings.quality;
+    q.preset = o.qualityPreset == "fast" ? Quality::Preset::Fast
+               : o.qualityPreset == "high" ? Quality::Preset::High
+                                           : Quality::Preset::Balanced;
+    if (app.count("--precision") > 0)
+        q.precision = o.precision == "32f" ? Quality::Precision::F32 : Quality::Precision::F16;
+    if (app.count("--hexagon") > 0)
+        q.hexagon = o.kernel == "mcintosh" ? Quality::Hexagon::McIntosh : Quality::Hexagon::Rhombi;
+    if (app.count("--near-field") > 0)
+        q.nearField = o.nearField;
+    if (app.count("--resolution") > 0)
+        q.resolution = o.resolution == "half" ? Quality::Resolution::Half : Quality::Resolution::Full;
+    q = resolve(q);
+    o.precision = *q.precision == Quality::Precision::F32 ? "32f" : "16f";
+    o.kernel = *q.hexagon == Quality::Hexagon::McIntosh ? "mcintosh" : "rhombi";
+    o.resolution = *q.resolution == Quality::Resolution::Half ? "half" : "full";
+    Lens& lens = o.settings.lens;
+    lens.cocModel = o.model == "focal-range" ? Lens::Model::FocalRange : Lens::Model::ThinLens;
+    lens.fovFrom = o.fov == "focal-length" ? Lens::FovFrom::FocalLength : Lens::FovFrom::ImageDistance;
+    for (std::size_t v = 0; v < std::size(kViewNames); ++v)
+        if (o.view == kViewNames[v])
+            o.settings.view = static_cast<Settings::View>(v);
     try {
         std::optional<cv::Point2d> point;
         if (!o.focusPoint.empty())
@@ -616,23 +654,34 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
         spdlog::error("{}", error.what());
         return kExitUsage;
     }
-    bool autoFocus = true; // auto, track and keys are checked frame by frame
-    if (o.focus != "auto" && o.focus != "track" && !FocusSchedule::isKeyed(o.focus) &&
-        !parseFocus(o.focus, o.lens, autoFocus)) {
-        spdlog::error("--focus '{}' is not metres, 'inf', 'auto', 'track' or keys", o.focus);
-        return kExitUsage;
+    // auto, track and keys are checked frame by frame; until then the focus is taken as at least
+    // twice the focal length, so that only the other settings are checked here.
+    const bool autoFocus = o.focus == "auto" || o.focus == "track" || FocusSchedule::isKeyed(o.focus);
+    if (!autoFocus) {
+        const std::optional<double> metres = parseMetres(o.focus);
+        if (!metres) {
+            spdlog::error("--focus '{}' is not metres, 'inf', 'auto', 'track' or keys", o.focus);
+            return kExitUsage;
+        }
+        lens.focusM = *metres;
     }
-    return cli::checkLensAndQuality(o.lens, o.quality, autoFocus);
+    Settings checked = o.settings;
+    if (autoFocus)
+        checked.lens.focusM = std::max(checked.lens.focusM, checked.lens.focalLengthMm * 2e-3);
+    const auto issues = check(checked);
+    for (const auto& issue : issues)
+        spdlog::error("{}", issue);
+    return issues.empty() ? std::nullopt : std::optional<int>(kExitUsage);
 }
 
 /// One clip with --report: the report is written after the clip, when it is done or failed on
 /// its input; a stopped clip or a GL failure leaves none (as --batch does).
-int runReported(const Options& options, std::optional<GlSession>& gl)
+int runReported(const Options& options, std::optional<Filter>& filter)
 {
     nlohmann::json report = nlohmann::json::object();
     int status = kExitDone;
     try {
-        status = runClip(options, gl, &report);
+        status = runClip(options, filter, &report);
     } catch (const std::exception& error) {
         spdlog::error("{}", error.what());
         status = cli::statusFor(error);
@@ -709,16 +758,16 @@ int runBatchCommand(const Options& global, const std::vector<std::string>& argum
     return batch::runBatch(
         batch::select(all, shard), options,
         [&](std::size_t) -> batch::ClipRunner {
-            // One context and one shader build for all of this worker's clips.
-            auto gl = std::make_shared<std::optional<GlSession>>();
-            gl->emplace(gl::EglContext::create(contextOptions(global)));
-            return [gl, &clipOptions](const batch::Clip& clip) {
+            // One filter (a context and one shader build) for all of this worker's clips, made and
+            // used on the worker's thread; each clip sets its settings and resets it.
+            auto filter = std::make_shared<std::optional<Filter>>();
+            filter->emplace(Settings{}, contextOptions(global));
+            return [filter, &clipOptions](const batch::Clip& clip) {
                 batch::ClipOutcome outcome;
                 Options o;
                 clipOptions(clip, o);
-                (*gl)->context.makeCurrent();
                 try {
-                    outcome.status = runClip(o, *gl, &outcome.report);
+                    outcome.status = runClip(o, *filter, &outcome.report);
                 } catch (const std::exception& error) {
                     spdlog::error("{}", error.what());
                     outcome.status = cli::statusFor(error);
@@ -756,8 +805,8 @@ int main(int argc, char** argv)
         if (const auto status = finishOptions(app, o))
             return *status;
         cli::catchStopSignals();
-        std::optional<GlSession> gl;
-        return o.report.empty() ? runClip(o, gl) : runReported(o, gl);
+        std::optional<Filter> filter;
+        return o.report.empty() ? runClip(o, filter) : runReported(o, filter);
     } catch (const std::exception& error) {
         spdlog::error("{}", error.what());
         return cli::statusFor(error);

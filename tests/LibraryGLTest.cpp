@@ -1,5 +1,7 @@
 // libdefocus' public API (include/defocus/): its errors speak the command line's words, the
-// command line's automatic focus, the live autofocus, and a Filter handed from thread to thread.
+// command line's automatic focus, the live autofocus, a Filter handed from thread to thread, and
+// what the defocus program takes from it: the contact sheet, the last frame's GPU times, the
+// renderer and the device, and a preset resolved.
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -180,6 +182,89 @@ TEST_F(Library, HandedToAnotherThreadAfterRelease)
     ASSERT_EQ(error, "");
     EXPECT_TRUE(identical(here, there));
     EXPECT_TRUE(identical(filter_->process(color_, depth_), here)) << "and back on this thread";
+}
+
+// Defect caught: contactSheet() that leaves the Filter in another state than a plain frame would
+// (the frame counter advanced, the timings or the next frame's result those of the views' reads),
+// or a sheet that lacks views.
+TEST_F(Library, ContactSheetLeavesTheFrameAsItWas)
+{
+    const Pair next = bundled(10);
+    const cv::Mat nextColor = cv::imread(next.color.string(), cv::IMREAD_COLOR);
+    const cv::Mat nextDepth = cv::imread(next.depth.string(), cv::IMREAD_UNCHANGED);
+    EXPECT_THROW(filter_->contactSheet(), defocus::InputError) << "no frame yet";
+    filter_->process(color_, depth_);
+    const cv::Mat sheet = filter_->contactSheet();
+    EXPECT_EQ(filter_->lastFrame().index, 0u);
+    EXPECT_FALSE(filter_->lastFrame().plan.allInFocus);
+    ASSERT_EQ(sheet.type(), CV_8UC3);
+    // 7 views and the plan, four to a row, each at least the frame's size.
+    EXPECT_GE(sheet.cols, 4 * color_.cols);
+    EXPECT_GE(sheet.rows, 2 * color_.rows);
+    const cv::Mat afterSheet = filter_->process(nextColor, nextDepth);
+    EXPECT_EQ(filter_->lastFrame().index, 1u);
+
+    defocus::Filter plain(settings_);
+    plain.process(color_, depth_);
+    EXPECT_TRUE(identical(plain.process(nextColor, nextDepth), afterSheet));
+}
+
+// Defect caught: the last frame's GPU times lost at the end of a stream (finishGpuTimings() not
+// waiting for them), or put to another frame than the one they measured.
+TEST_F(Library, LastFramesGpuTimesAtTheEnd)
+{
+    if (!filter_->rendererInfo().timerQueries)
+        GTEST_SKIP() << "this driver has no GPU timer queries";
+    filter_->process(color_, depth_);
+    EXPECT_TRUE(filter_->lastFrame().timings.gpu.empty()) << "read one frame late";
+    filter_->process(color_, depth_);
+    EXPECT_FALSE(filter_->lastFrame().timings.gpu.empty());
+    EXPECT_EQ(filter_->lastFrame().timings.gpuFrame, 0u);
+    const auto last = filter_->finishGpuTimings();
+    ASSERT_FALSE(last.empty()) << "frame 1's passes";
+    for (const auto& pass : last) {
+        EXPECT_FALSE(pass.name.empty());
+        EXPECT_GE(pass.ms, 0.0) << pass.name;
+    }
+}
+
+// Defect caught: rendererInfo()/probeRenderer() describing another context than the one the
+// filter renders in, or an EGL device that does not exist quietly replaced by another (the
+// command line's --egl-device promises only that one).
+TEST_F(Library, RendererAndDevice)
+{
+    const defocus::RendererInfo info = filter_->rendererInfo();
+    EXPECT_EQ(info.glRenderer, filter_->renderer());
+    EXPECT_FALSE(info.platform.empty());
+    EXPECT_NE(info.glVersion.find("4."), std::string::npos) << info.glVersion;
+    const defocus::RendererInfo probed = defocus::probeRenderer();
+    EXPECT_EQ(probed.glRenderer, info.glRenderer);
+    EXPECT_EQ(probed.eglDevice, info.eglDevice);
+    const int none = static_cast<int>(defocus::eglDevices().size()) + 7;
+    EXPECT_THROW(defocus::Filter(settings_, defocus::ContextOptions{none}), defocus::GlError);
+    EXPECT_THROW(defocus::probeRenderer(defocus::ContextOptions{none}), defocus::GlError);
+}
+
+// Defect caught: resolve() leaving fields empty (a report that says null where the filter ran
+// the preset's value), or overriding a field the caller set.
+TEST(LibrarySettings, ResolveFillsThePresetsValues)
+{
+    defocus::Quality high;
+    high.preset = defocus::Quality::Preset::High;
+    const defocus::Quality resolved = defocus::resolve(high);
+    EXPECT_EQ(resolved.samples, 12);
+    EXPECT_EQ(resolved.resolution, defocus::Quality::Resolution::Full);
+    EXPECT_EQ(resolved.hexagon, defocus::Quality::Hexagon::Rhombi);
+    EXPECT_EQ(resolved.precision, defocus::Quality::Precision::F32);
+    EXPECT_EQ(resolved.nearField, true);
+    defocus::Quality fast;
+    fast.preset = defocus::Quality::Preset::Fast;
+    fast.samples = 9;
+    fast.nearField = false;
+    const defocus::Quality mixed = defocus::resolve(fast);
+    EXPECT_EQ(mixed.samples, 9);
+    EXPECT_EQ(mixed.nearField, false);
+    EXPECT_EQ(mixed.resolution, defocus::Quality::Resolution::Half);
 }
 
 } // namespace

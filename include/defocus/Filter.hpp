@@ -8,11 +8,15 @@
 // made current on the thread that calls it (construction, process(), the destructor) and stays
 // current there until release(); before another thread uses the Filter, release() it on the
 // thread that used it last. Different Filters are independent and may run on different threads
-// at once. check(), version() and the settings structs are plain data and functions.
+// at once. check(), version(), eglDevices(), probeRenderer() and the structs are plain data and
+// functions that any thread may call (probeRenderer() makes and drops a context of its own).
+// Several clips, one after the other, can share one Filter (one context, one shader build):
+// setSettings() and reset() between them, as `defocus --batch` does.
 #pragma once
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -76,6 +80,40 @@ struct Plan {
     std::string explain;              ///< one line, as `defocus --explain` prints it
 };
 
+/// Where the filter renders. Chosen once, when the Filter is made.
+struct ContextOptions {
+    /// EGL device to render on, only that one (an index of eglDevices()). nullopt: the GPU that
+    /// CUDA_VISIBLE_DEVICES makes CUDA's first, else the first device that works, else Mesa's
+    /// surfaceless platform. The command line's --egl-device.
+    std::optional<int> eglDevice;
+};
+
+/// One EGL device of the machine (the command line's `--info` lists them).
+struct EglDevice {
+    int index = 0;              ///< what ContextOptions::eglDevice takes
+    bool software = false;      ///< a software renderer (Mesa llvmpipe)
+    std::string drmFile;        ///< e.g. "/dev/dri/card1"; empty where the driver does not say
+    std::optional<int> cudaId;  ///< the CUDA device it is, as this process's CUDA numbers them
+};
+
+/// The context a Filter renders in.
+struct RendererInfo {
+    std::string platform;    ///< EGL platform: "device" or "surfaceless"
+    int eglDevice = -1;      ///< index of the EGL device in use; -1 on the surfaceless platform
+    std::string eglVendor;   ///< EGL_VENDOR
+    std::string eglVersion;  ///< EGL_VERSION
+    std::string glVendor;    ///< GL_VENDOR
+    std::string glRenderer;  ///< GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+    std::string glVersion;   ///< GL_VERSION
+    bool timerQueries = false; ///< the driver has GPU timer queries (Timings::gpu is filled)
+};
+
+/// The EGL devices of this machine; empty where EGL cannot enumerate them.
+DEFOCUS_API std::vector<EglDevice> eglDevices();
+/// Makes an OpenGL 4.5 context as a Filter would (no shaders compiled), says what it is and
+/// drops it. Throws GlError where none can be made.
+DEFOCUS_API RendererInfo probeRenderer(const ContextOptions& context = {});
+
 /// The last processed frame.
 struct FrameReport {
     std::size_t index = 0; ///< frames since construction or reset(), from 0
@@ -90,6 +128,8 @@ public:
     /// first Filter of a process takes a second or more on llvmpipe. Throws SettingsError for
     /// settings out of range and GlError where no OpenGL 4.5 context can be made.
     explicit Filter(const Settings& settings = {});
+    /// The same, on the device that `context` chooses.
+    Filter(const Settings& settings, const ContextOptions& context);
     ~Filter();
     Filter(Filter&&) noexcept;
     Filter& operator=(Filter&&) noexcept;
@@ -114,12 +154,26 @@ public:
 
     /// The last frame's timings and plan (valid after the first process()).
     const FrameReport& lastFrame() const;
+    /// The GPU times of the last frame, waiting for the GPU (otherwise they come one frame late,
+    /// with the next frame's Timings::gpu): call once at the end of a stream. They belong to
+    /// frame lastFrame().index; empty before the first frame and without timer queries.
+    std::vector<Timings::Pass> finishGpuTimings();
+    /// Every view of the last processed frame (Settings::View, in its order, each labelled with
+    /// its number and name) and the plan (tiles blurred outlined, copied dimmed, near field
+    /// blue), read back as 8-bit sRGB and laid out on one labelled CV_8UC3 sheet, four to a
+    /// row: the command line's --contact-sheet. Call it right after process(), with that call's
+    /// images unchanged: the frame is processed again afterwards, so that lastFrame() and the
+    /// GPU times stay those of a plain frame (lastFrame().index does not advance). Throws
+    /// InputError before the first process().
+    cv::Mat contactSheet();
     /// A new stream: the next frame is frame 0 again, and the autofocus measures afresh.
     void reset();
     /// Unbinds the EGL context from the calling thread, so that another thread can use the Filter.
     void release();
     /// The OpenGL renderer, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
     std::string renderer() const;
+    /// The context: platform, device, vendors and versions.
+    RendererInfo rendererInfo() const;
 
 private:
     struct Impl;

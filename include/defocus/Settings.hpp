@@ -134,6 +134,9 @@ struct Settings {
 /// value out of range is replaced by the nearest allowed one (the messages say what was wrong).
 DEFOCUS_API std::vector<std::string> check(Settings& settings, bool clamp = false);
 
+/// `quality` with every field left empty set to its preset's value (what the filter runs).
+DEFOCUS_API Quality resolve(const Quality& quality);
+
 /// The library's version, "MAJOR.MINOR.PATCH".
 DEFOCUS_API std::string version();
 
