@@ -1,7 +1,6 @@
 // Resolution::Half: the blurs at half size, the output at the frame's size with its in-focus
 // pixels kept (coc.frag HALF_SIZE, upscale_prefilter.frag, upscale.frag).
 #include <array>
-#include <cstdio>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -253,8 +252,10 @@ TEST_F(HalfSize, QuarterSizeBlurMatchesTheHalfSizeBlur)
     // (quarterOnLargeBlur off): what a clip shows when a frame crosses the rule. Defects caught:
     // a quarter-size result out of place (the upscale's coordinates at half size's scale, or
     // the CoC pass's blocks misaligned), or its CoC in the wrong unit (half-size pixels: a blur
-    // twice as large); each a seam in time where a clip switches between the sizes.
-    // MEASURED_BOUND is set in the comment below.
+    // twice as large); each a seam in time where a clip switches between the sizes. Measured on
+    // llvmpipe: 0.42 8-bit levels of mean absolute difference; the upscale reading the quarter-
+    // size result at half size's coordinates 2.73, the CoC in half-size pixels 1.42. 1.0 catches
+    // both and leaves room for other drivers.
     const Frame frame = textured({160, 128}, 0);
     const LensSettings lens = test::lensWithFarCoc(40.0);
     Pipeline quarterPipeline, halfPipeline;
@@ -268,9 +269,7 @@ TEST_F(HalfSize, QuarterSizeBlurMatchesTheHalfSizeBlur)
     cv::Mat diff;
     cv::absdiff(encodeSrgb(quarter(inside)), encodeSrgb(half(inside)), diff);
     const cv::Scalar meanDiff = cv::mean(diff);
-    const double levels = (meanDiff[0] + meanDiff[1] + meanDiff[2]) / 3.0;
-    std::printf("quarter vs half: %.3f levels\n", levels);
-    EXPECT_LT(levels, 100.0);
+    EXPECT_LT((meanDiff[0] + meanDiff[1] + meanDiff[2]) / 3.0, 1.0);
 }
 
 } // namespace
