@@ -89,6 +89,7 @@ QualitySettings toQuality(const Quality& quality)
                                                                                             : Resolution::Full)
                                         : preset.resolution;
     out.highlightSprites = quality.highlightSprites;
+    out.quarterOnLargeBlur = preset.quarterOnLargeBlur;
     out.highlightGain = quality.highlightGain;
     out.adaptive = !quality.alwaysOn;
     return out;

@@ -103,12 +103,13 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
         for (const Preset& preset : presets())
             chosen.push_back({std::string(preset.name), preset});
     for (const std::string& label : options.presets) {
-        // NAME, then any of :half-only and :no-sprites.
+        // NAME, then any of :quarter, :half-only and :no-sprites.
         std::string_view name = label;
-        bool halfOnly = false, noSprites = false;
+        bool quarter = false, halfOnly = false, noSprites = false;
         for (bool found = true; found;) {
             found = false;
-            for (const auto& [suffix, flag] : {std::pair<std::string_view, bool*>{":half-only", &halfOnly},
+            for (const auto& [suffix, flag] : {std::pair<std::string_view, bool*>{":quarter", &quarter},
+                                               std::pair<std::string_view, bool*>{":half-only", &halfOnly},
                                                std::pair<std::string_view, bool*>{":no-sprites", &noSprites}})
                 if (name.ends_with(suffix)) {
                     name.remove_suffix(suffix.size());
@@ -116,8 +117,10 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
                 }
         }
         Preset p = preset(name); // throws, naming the presets there are
-        p.settings.quarterOnLargeBlur = !halfOnly;
-        p.settings.highlightSprites = !noSprites;
+        if (quarter || halfOnly)
+            p.settings.quarterOnLargeBlur = quarter && !halfOnly;
+        if (noSprites)
+            p.settings.highlightSprites = false;
         chosen.push_back({label, p});
     }
     // Every scene is read and checked before the first is measured: a bad folder fails at once.

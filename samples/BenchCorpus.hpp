@@ -17,8 +17,9 @@ struct CorpusOptions {
     std::string anchors;
     bool missingOk = false;  ///< a --scene folder that does not exist: exit 77 (skipped), not 1
     bool saveOutputs = false; ///< also every preset's result, OUT/outputs/SCENE/PRESET.exr
-    /// Names of the presets to run; empty: all. NAME:half-only is the preset with quarter size
-    /// on large blur off (MethodSettings::quarterOnLargeBlur), to compare the two in one run;
+    /// Names of the presets to run; empty: all. NAME:quarter is the preset with quarter size on
+    /// large blur on (MethodSettings::quarterOnLargeBlur), NAME:half-only with it off (the presets'
+    /// own setting), to compare the two in one run;
     /// NAME:no-sprites the preset without bokeh sprites (lights gathered like any pixel), as a
     /// frame the plan gives no sprites runs; the two combine.
     std::vector<std::string> presets;

@@ -64,6 +64,7 @@ struct Options {
     bool noTimers = false;
     bool noAdaptive = false;
     bool finishEachPass = false;
+    bool quarterOnLargeBlur = false; ///< QualitySettings::quarterOnLargeBlur on (the presets leave it off)
     /// Also time the defocused scene always at half size (QualitySettings::quarterOnLargeBlur
     /// off: the path before quarter size), in a second pipeline, frame by frame alternating with
     /// the first: before and after as a ratio within one run.
@@ -401,6 +402,8 @@ int run(const Options& options, const std::string& commandLine)
     if (options.nearField)
         quality.nearField = *options.nearField;
     quality.adaptive = !options.noAdaptive;
+    if (options.quarterOnLargeBlur)
+        quality.quarterOnLargeBlur = true;
     const std::string precision = quality.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
     LensSettings baseLens;
     baseLens.model = CocModel::ThinLens;
@@ -446,7 +449,9 @@ int run(const Options& options, const std::string& commandLine)
     fmt::print("clip: {} ({} frames, cycled); --quality {}: {} {} taps{}, {} size, {}, {}; {} runs after {} warm-up "
                "frames per scene\n",
                options.data, clip.size(), options.preset, kernelName(quality.kernel), quality.samples,
-               quality.nearField ? " + near field" : "", resolutionName(quality.resolution),
+               quality.nearField ? " + near field" : "",
+               quality.resolution == Resolution::Half && quality.quarterOnLargeBlur ? "half (quarter on large blur)"
+                                                                                    : resolutionName(quality.resolution),
                precision == "32f" ? "RGBA32F" : "RGBA16F",
                quality.adaptive ? "adaptive (in-focus frames and tiles skipped)" : "every pass on every pixel",
                options.runs, options.warmup);
@@ -545,6 +550,7 @@ int run(const Options& options, const std::string& commandLine)
               {"adaptive", quality.adaptive},
               {"finishEachPass", options.finishEachPass},
               {"versusHalfOnly", options.versusHalfOnly},
+              {"quarterOnLargeBlur", quality.quarterOnLargeBlur},
               {"focusM", options.focusM},
               {"fNumber", options.fNumber},
               {"focalLengthMm", options.focalLengthMm},
@@ -665,6 +671,9 @@ int main(int argc, char** argv)
         ->check(CLI::IsMember({"16f", "32f"}));
     app.add_option("--resolution", o.resolution, "Size of the blurs: full or half [default: from --quality]")
         ->check(CLI::IsMember({"full", "half"}));
+    app.add_flag("--quarter-on-large-blur", o.quarterOnLargeBlur,
+                 "Half size goes to quarter size on frames whose blur is mostly beyond 32 px and that have no "
+                 "bokeh sprites (off in the presets: docs/benchmarks.md)");
     app.add_flag("--versus-half-only", o.versusHalfOnly,
                  "Also time the defocused scene always at half size (quarter size on large blur off: the path "
                  "before it), frames alternating with the main settings', and print the ratio of frame times");

@@ -818,9 +818,9 @@ int main(int argc, char** argv)
                    "gegl-lens-blur}.exr (scripts/corpus/anchors.py), measured beside the presets");
     std::string presetList;
     app.add_option("--presets", presetList,
-                   "scene folders only: comma-separated presets to run (default: all); NAME:half-only runs "
-                   "preset NAME always at half size (no quarter size on large blur), NAME:no-sprites without "
-                   "bokeh sprites (both: NAME:no-sprites:half-only), to compare them");
+                   "scene folders only: comma-separated presets to run (default: all); NAME:quarter runs "
+                   "preset NAME with quarter size on large blur, NAME:half-only without (the presets' own), "
+                   "NAME:no-sprites without bokeh sprites (they combine: NAME:no-sprites:quarter)");
     app.add_option("--scale", corpus.scale,
                    "scene folders only: enlarge every scene by this factor (colour and truth bilinear, depth "
                    "nearest, lens unchanged: the CoC in pixels grows with it), to judge large frames' blur")
