@@ -128,8 +128,8 @@ struct Pipeline::Impl {
     gl::Texture nearDiameter;            ///< per tile, R32F
 
     cv::Size size;     ///< the frame's
-    cv::Size blurSize; ///< the blur passes': the frame's, or half of it (Resolution::Half)
-    int blurShift = 0; ///< log2 of size / blurSize
+    cv::Size blurSize; ///< the blur passes': the frame's, or half or a quarter of it (Resolution::Half)
+    int blurShift = 0; ///< log2 of size / blurSize (the plan's FramePlan::blurShift)
     PreparedDepth prepared;
     float maxCocPx = 0.0f;
     FrameTimings timings;
@@ -167,6 +167,12 @@ struct Pipeline::Impl {
     }
     void uploadNearDiameter();
     void prepareDepthAndPlan();
+    void setBlurShift(int shift)
+    {
+        blurShift = shift;
+        const int round = (1 << shift) - 1;
+        blurSize = {(size.width + round) >> shift, (size.height + round) >> shift};
+    }
     /// The analysis' tiles in the blur passes' pixels.
     int tileSize() const { return SceneAnalysis::kTileSize >> blurShift; }
     /// Half size: the blurred result into `blurred`, then upscaled with the frame into `out`.
@@ -232,8 +238,7 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     p.timings = {};
     p.frameStart = Clock::now();
     p.size = frame.color.size();
-    p.blurShift = quality.resolution == Resolution::Half ? 1 : 0;
-    p.blurSize = {(p.size.width + p.blurShift) >> p.blurShift, (p.size.height + p.blurShift) >> p.blurShift};
+    p.setBlurShift(quality.resolution == Resolution::Half ? 1 : 0);
 
     auto start = Clock::now();
     p.color = frame.color;
@@ -296,7 +301,9 @@ void Pipeline::Impl::prepareDepthAndPlan()
     analysis = finishAnalysis(sceneAnalysisPass.run(depth, colorTexture, srgbInput, coefficients), coefficients,
                               prepared.invalidFraction);
     const bool allInFocus = plan.allInFocus && quality.adaptive;
-    plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples);
+    plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples,
+                    quality.quarterOnLargeBlur);
+    setBlurShift(plan.blurShift);
     if (color.type() == CV_8UC3 && plan.highlights && !plan.allInFocus)
         plan.highlightGain = quality.highlightGain;
     // Sprites where a blurred pixel can be brighter than white: float input's highlights, or
@@ -306,6 +313,17 @@ void Pipeline::Impl::prepareDepthAndPlan()
                             plan.highlights && !plan.allInFocus &&
                             (color.type() != CV_8UC3 || plan.highlightGain > 1.0) &&
                             analysis.highlightFraction <= HighlightSpritePass::kMostHighlightPixels;
+    // Quarter size only on frames without bokeh sprites: the rims of the lights' hexagons, which
+    // the gather draws up to white, came out 4 px soft at quarter size (the corpus enlarged 3x,
+    // `defocus-bench accuracy --scale 3`: 0.38 dB less in the median, most of it in the lights'
+    // zone; docs/benchmarks.md).
+    if (plan.highlightSprites && plan.blurShift == 2) {
+        const FramePlan quarter = plan;
+        plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples, false);
+        plan.highlightGain = quarter.highlightGain;
+        plan.highlightSprites = quarter.highlightSprites;
+        setBlurShift(plan.blurShift);
+    }
     plan.allInFocus = plan.allInFocus || allInFocus;
 }
 
@@ -426,7 +444,7 @@ void Pipeline::Impl::upscale(const gl::Framebuffer& out)
     upscalePass.prefilter(io);
     timer.end();
     timer.begin(UpscalePass::kName);
-    upscalePass.upscale(io, coefficients, quality.targetFormat == TargetFormat::Rgba16F,
+    upscalePass.upscale(io, coefficients, quality.targetFormat == TargetFormat::Rgba16F, blurShift,
                         upscaleUsesTiles ? &detailTiles : nullptr);
     timer.end();
 }
@@ -465,7 +483,7 @@ void Pipeline::Impl::render()
                                                              analysis.highlightPixels));
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
     cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
-                blurShift != 0, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
+                blurShift, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
                 &sceneAnalysisPass.measurement(), &highlightSpritePass.sprites());
     timer.end();
     rhombiSecondPending = false;
@@ -610,6 +628,11 @@ std::vector<PassTime> Pipeline::drainGpuTimes()
     for (auto& [name, ms] : impl_->timer.drain())
         times.push_back({name, ms});
     return times;
+}
+
+void Pipeline::finishEachPass(bool on)
+{
+    impl_->timer.finishEachScope(on);
 }
 
 const SceneAnalysis& Pipeline::analysis() const

@@ -79,6 +79,12 @@ public:
     /// GPU times of the last frame, waiting for them (call once at the end of a stream).
     std::vector<PassTime> drainGpuTimes();
 
+    /// Profiling: wait for the GPU (glFinish) before and after every timed pass and report each
+    /// pass's wall time in FrameTimings::gpu instead of its timer query. On llvmpipe, which
+    /// renders when a flush or readback needs it, this is what puts each pass's cost on its
+    /// own row; it removes the overlap of CPU and GPU work, so the frame is slower.
+    void finishEachPass(bool on);
+
     /// What the last frame called for, and what ran.
     const SceneAnalysis& analysis() const;
     const FramePlan& plan() const;

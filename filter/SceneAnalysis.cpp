@@ -135,10 +135,27 @@ SceneAnalysis analyseScene(const cv::Mat& filledDepth, const cv::Mat& color, con
     return finishAnalysis(measureScene(filledDepth, color, k), k, invalidDepthFraction);
 }
 
+int halfOrQuarterShift(const SceneAnalysis& analysis)
+{
+    // Histogram bins: |CoC| below each edge; the last bin takes the rest.
+    const auto& edges = SceneAnalysis::kHistogramEdges;
+    std::size_t blurred = 0, large = 0;
+    for (std::size_t i = 0; i < analysis.histogram.size(); ++i) {
+        const float lower = i == 0 ? 0.0f : edges[i - 1];
+        const auto count = static_cast<std::size_t>(std::max(analysis.histogram[i], 0));
+        if (lower >= 1.0f)
+            blurred += count;
+        if (lower >= kQuarterCocPx)
+            large += count;
+    }
+    return blurred > 0 && static_cast<double>(large) > kQuarterShare * static_cast<double>(blurred) ? 2 : 1;
+}
+
 FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel kernel, Resolution resolution,
-                   int taps)
+                   int taps, bool quarterOnLargeBlur)
 {
     FramePlan plan;
+    plan.blurShift = resolution == Resolution::Full ? 0 : quarterOnLargeBlur ? halfOrQuarterShift(analysis) : 1;
     plan.allInFocus = analysis.maxAbsCoc() < 0.5f;
     plan.holeFill = analysis.invalidDepthFraction > 0.0;
     plan.highlights = analysis.highlightFraction > 0.0;
@@ -158,11 +175,12 @@ FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel 
             // The rhombus blur handles the foreground itself: tiles it reaches are blurred too.
             const bool blur = analysis.tileNeedsBlur(x, y, sharpBelow) || (near && kernel == HexagonKernel::RhombiSum);
             (blur ? plan.blurTiles : plan.copyTiles).emplace_back(x, y);
-            if (resolution == Resolution::Half) {
-                // upscale.frag's detail weight is 0 from |CoC| = 2 px: a tile whose whole range
-                // lies beyond has nothing to put back.
-                const bool detail = analysis.tileMinCoc.at<float>(y, x) < kUpscaleDetailBelowPx &&
-                                    analysis.tileMaxCoc.at<float>(y, x) > -kUpscaleDetailBelowPx;
+            if (plan.blurShift != 0) {
+                // upscale.frag's detail weight is 0 from |CoC| = 2 px (4 at quarter size): a
+                // tile whose whole range lies beyond has nothing to put back.
+                const float detailBelow = upscaleDetailBelowPx(plan.blurShift);
+                const bool detail = analysis.tileMinCoc.at<float>(y, x) < detailBelow &&
+                                    analysis.tileMaxCoc.at<float>(y, x) > -detailBelow;
                 if (detail)
                     plan.detailTiles.emplace_back(x, y);
             }
@@ -175,7 +193,7 @@ FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel 
     // per frame with plain loops of 6 taps against 16.5 unrolled; the Blender scene at full size
     // (most lines 7 px) 38.6 ms unrolled against 43.8.
     if (kernel == HexagonKernel::RhombiSum && taps > 0 && !plan.blurTiles.empty()) {
-        const float scale = resolution == Resolution::Half ? 0.25f : 0.5f;
+        const float scale = 0.5f / static_cast<float>(1 << plan.blurShift);
         std::size_t saturated = 0;
         for (const cv::Point& tile : plan.blurTiles) {
             const float blur = std::max(std::abs(analysis.tileMinCoc.at<float>(tile)),
@@ -199,8 +217,9 @@ std::string FramePlan::explain(const SceneAnalysis& analysis) const
                                                 analysis.maxCoc);
     if (allInFocus)
         return text + " (hole filling and analysis skipped)";
-    if (resolution == Resolution::Half)
-        text += fmt::format("; half size, upscale puts detail back on {}/{} tiles", detailTiles.size(), total);
+    if (blurShift != 0)
+        text += fmt::format("; {} size, upscale puts detail back on {}/{} tiles", blurShift == 2 ? "quarter" : "half",
+                            detailTiles.size(), total);
     text += holeFill ? fmt::format("; hole fill on ({:.1f} % invalid)", 100.0 * analysis.invalidDepthFraction)
                      : "; hole fill off (no holes)";
     if (kernel == HexagonKernel::RhombiSum)

@@ -14,8 +14,20 @@
 namespace defocus {
 
 /// Resolution::Half: the upscale (upscale.frag) puts the frame's own pixels back under this
-/// |CoC|, fully up to half of it and fading out to it.
+/// |CoC|, fully up to half of it and fading out to it. At quarter size twice that
+/// (upscaleDetailBelowPx()): below 4 px a quarter-size blur leaves its pixels alone.
 inline constexpr float kUpscaleDetailBelowPx = 2.0f;
+
+/// The upscale's detail limit for blurs at 1 / 2^blurShift of the frame's size (blurShift 1 or 2).
+inline float upscaleDetailBelowPx(int blurShift)
+{
+    return kUpscaleDetailBelowPx * static_cast<float>(1 << (blurShift - 1));
+}
+
+/// quarterOnLargeBlur: a frame goes to quarter size when more than this share of its blurred
+/// pixels (|CoC| >= 1 px) have |CoC| >= kQuarterCocPx (see makePlan()).
+inline constexpr float kQuarterCocPx = 32.0f;
+inline constexpr double kQuarterShare = 0.1;
 
 struct SceneAnalysis {
     static constexpr int kTileSize = 16; ///< pixels per tile side
@@ -82,6 +94,9 @@ struct FramePlan {
     /// frame's own detail back (upscale.frag); on the others it only interpolates the blur.
     std::vector<cv::Point> detailTiles;
     Resolution resolution = Resolution::Full; ///< the blur passes' size, for explain()
+    /// log2 of the frame's size over the blur passes': 0 full, 1 half, 2 quarter (Half with
+    /// quarterOnLargeBlur on a frame whose blur is large).
+    int blurShift = 0;
     /// Gain of the 8-bit highlight recovery in the CoC pass; 1 = not run (set by the pipeline).
     double highlightGain = 1.0;
     /// Rhombi: the light of blurred pixels above white goes to bokeh sprites (set by the pipeline
@@ -98,9 +113,15 @@ struct FramePlan {
 /// `nearField`: spread foreground blur when the frame has some: McIntosh runs the foreground
 /// layer on nearTiles; the rhombus blur reaches over them itself, so they join blurTiles.
 /// `resolution` Half also sorts the tiles for the upscale (detailTiles). `taps` (rhombi): the
-/// most taps per line, for unrolledTaps; 0 leaves the loops plain.
+/// most taps per line, for unrolledTaps; 0 leaves the loops plain. `quarterOnLargeBlur` (Half
+/// only): quarter size (blurShift 2) when more than kQuarterShare of the blurred pixels have
+/// |CoC| >= kQuarterCocPx, the frame's large blur then spanning no more quarter-size pixels
+/// than the 640x480 defaults' largest (32 px) spans half-size ones.
 FramePlan makePlan(const SceneAnalysis& analysis, bool nearField = true,
                    HexagonKernel kernel = HexagonKernel::McIntoshMin, Resolution resolution = Resolution::Full,
-                   int taps = 0);
+                   int taps = 0, bool quarterOnLargeBlur = false);
+
+/// The size makePlan() chooses for Half with quarterOnLargeBlur: 2 (quarter) or 1 (half).
+int halfOrQuarterShift(const SceneAnalysis& analysis);
 
 } // namespace defocus

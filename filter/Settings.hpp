@@ -73,7 +73,9 @@ enum class Resolution {
     /// The CoC pass averages 2x2 pixels into a (w + 1) / 2 x (h + 1) / 2 target (CoC in pixels
     /// halves with the size), the blurs run there, and an upscale pass makes the frame-sized
     /// output: the blurred result interpolated, with the frame's own pixels put back where they
-    /// are in focus (upscale.frag). About a quarter of the blur's cost.
+    /// are in focus (upscale.frag). About a quarter of the blur's cost. With
+    /// QualitySettings::quarterOnLargeBlur, frames whose blur is large go to quarter size
+    /// instead (FramePlan::blurShift).
     Half
 };
 
@@ -127,6 +129,13 @@ struct QualitySettings {
     /// hexagons with exact edges (bokeh sprites), added to the result. Runs only on frames with
     /// such pixels.
     bool highlightSprites = true;
+    /// Resolution::Half: the blurs run at quarter size on frames whose blur is large, as at
+    /// 1920x1080 with max-coc scaled with the width: there a quarter-size pixel spans about
+    /// as much of the CoC as a half-size one at 640x480 (makePlan() decides; FramePlan::blurShift),
+    /// unless the frame has bokeh sprites (whose rims quarter size softens: the pipeline keeps
+    /// those at half size). Off by default and in every preset: on the corpus enlarged 3x it
+    /// cost 0.4 dB in the median (docs/benchmarks.md, "Quarter size on large blur").
+    bool quarterOnLargeBlur = false;
 };
 
 /// What the pipeline writes out. The first five are the McIntosh lab's modes 1-5.

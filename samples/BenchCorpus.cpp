@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
@@ -93,13 +94,35 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
         for (const fs::path& dir : findAccuracyScenes(path))
             dirs.push_back(dir);
     }
-    std::vector<Preset> chosen;
-    for (const Preset& preset : presets())
-        if (options.presets.empty() ||
-            std::find(options.presets.begin(), options.presets.end(), preset.name) != options.presets.end())
-            chosen.push_back(preset);
-    for (const std::string& name : options.presets)
-        (void)preset(name); // throws, naming the presets there are
+    struct Chosen {
+        std::string label; ///< the preset's name, or NAME:half-only
+        Preset preset;
+    };
+    std::vector<Chosen> chosen;
+    if (options.presets.empty())
+        for (const Preset& preset : presets())
+            chosen.push_back({std::string(preset.name), preset});
+    for (const std::string& label : options.presets) {
+        // NAME, then any of :quarter, :half-only and :no-sprites.
+        std::string_view name = label;
+        bool quarter = false, halfOnly = false, noSprites = false;
+        for (bool found = true; found;) {
+            found = false;
+            for (const auto& [suffix, flag] : {std::pair<std::string_view, bool*>{":quarter", &quarter},
+                                               std::pair<std::string_view, bool*>{":half-only", &halfOnly},
+                                               std::pair<std::string_view, bool*>{":no-sprites", &noSprites}})
+                if (name.ends_with(suffix)) {
+                    name.remove_suffix(suffix.size());
+                    *flag = found = true;
+                }
+        }
+        Preset p = preset(name); // throws, naming the presets there are
+        if (quarter || halfOnly)
+            p.settings.quarterOnLargeBlur = quarter && !halfOnly;
+        if (noSprites)
+            p.settings.highlightSprites = false;
+        chosen.push_back({label, p});
+    }
     // Every scene is read and checked before the first is measured: a bad folder fails at once.
     std::vector<AccuracyScene> scenes;
     for (const fs::path& dir : dirs)
@@ -114,7 +137,13 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
     std::map<std::string, std::unique_ptr<Method>> methods;
     std::vector<SceneResult> results;
     for (const AccuracyScene& scene : scenes) {
-        const AccuracyImages images = readAccuracyImages(scene);
+        AccuracyImages images = readAccuracyImages(scene);
+        if (options.scale != 1) {
+            const cv::Size size = images.color.size() * options.scale;
+            cv::resize(images.color, images.color, size, 0, 0, cv::INTER_LINEAR);
+            cv::resize(images.truth, images.truth, size, 0, 0, cv::INTER_LINEAR);
+            cv::resize(images.depth, images.depth, size, 0, 0, cv::INTER_NEAREST);
+        }
         SceneResult result{scene, 0.0, {}};
         LensSettings lens = scene.lens;
         // max-coc from the scene: the largest CoC of its depth, so that nothing is clamped (the
@@ -134,14 +163,14 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
         };
         measure("input", images.color, std::nan(""));
         const Frame frame{images.color, images.depth, 0.0, 0, scene.name};
-        for (const Preset& preset : chosen) {
+        for (const auto& [label, preset] : chosen) {
             auto& method = methods[std::string(preset.method)];
             if (!method)
                 method = createMethod(preset.method, false);
             const MethodResult out = method->run(frame, lens, preset.settings);
-            measure(std::string(preset.name), out.linear, out.wallMs);
+            measure(label, out.linear, out.wallMs);
             if (options.saveOutputs) {
-                const fs::path file = fs::path(options.out) / "outputs" / scene.name / fmt::format("{}.exr", preset.name);
+                const fs::path file = fs::path(options.out) / "outputs" / scene.name / fmt::format("{}.exr", label);
                 fs::create_directories(file.parent_path());
                 if (!cv::imwrite(file.string(), out.linear))
                     throw std::runtime_error(fmt::format("cannot write {}", file.string()));
@@ -165,8 +194,8 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
 
     // The per-scene table.
     std::vector<std::string> columns{"input"};
-    for (const Preset& preset : chosen)
-        columns.emplace_back(preset.name);
+    for (const Chosen& c : chosen)
+        columns.push_back(c.label);
     if (!options.anchors.empty())
         for (const char* anchor : kAnchors)
             columns.emplace_back(anchor);

@@ -17,7 +17,16 @@ struct CorpusOptions {
     std::string anchors;
     bool missingOk = false;  ///< a --scene folder that does not exist: exit 77 (skipped), not 1
     bool saveOutputs = false; ///< also every preset's result, OUT/outputs/SCENE/PRESET.exr
-    std::vector<std::string> presets; ///< names of the presets to run; empty: all
+    /// Names of the presets to run; empty: all. NAME:quarter is the preset with quarter size on
+    /// large blur on (MethodSettings::quarterOnLargeBlur), NAME:half-only with it off (the presets'
+    /// own setting), to compare the two in one run;
+    /// NAME:no-sprites the preset without bokeh sprites (lights gathered like any pixel), as a
+    /// frame the plan gives no sprites runs; the two combine.
+    std::vector<std::string> presets;
+    /// Every scene enlarged by this factor before it is measured: colour and truth bilinear,
+    /// depth nearest, the lens unchanged, so that the CoC in pixels grows with the size (a
+    /// 640x480 scene at 3 stands for 1920x1440). 1: as it is.
+    int scale = 1;
 };
 
 /// Exit status: 0 done, 1 runtime failure (a bad scene folder, output), 77 skipped (a

@@ -61,6 +61,12 @@ struct Options : cli::QualityNames {
     double maxCocAt640 = 32.0;
     bool noTimers = false;
     bool noAdaptive = false;
+    bool finishEachPass = false;
+    bool quarterOnLargeBlur = false; ///< QualitySettings::quarterOnLargeBlur on (the presets leave it off)
+    /// Also time the defocused scene always at half size (QualitySettings::quarterOnLargeBlur
+    /// off: the path before quarter size), in a second pipeline, frame by frame alternating with
+    /// the first: before and after as a ratio within one run.
+    bool versusHalfOnly = false;
     std::string json;
 };
 
@@ -78,6 +84,8 @@ struct SceneResult {
     std::vector<Series> gpu;
     std::vector<Series> wall;
     double othersCpuShare = -1.0; ///< CPU share other processes used during the runs; -1 unknown
+    int quarterFrames = 0;        ///< measured frames whose plan blurred at quarter size
+    int measuredFrames = 0;
 };
 
 /// How the lens spreads blur over the defocused scene, so the figures can be read against it.
@@ -239,61 +247,87 @@ Series& seriesNamed(std::vector<Series>& all, const std::string& key, const std:
     return all.back();
 }
 
-/// Runs `frames` (cycled) through the pipeline: `options.warmup` frames unmeasured, then
-/// `options.runs` measured ones. GPU timer results arrive one frame late, tagged with the index
-/// of the frame they belong to, so every frame gets a unique index and one extra frame at the
-/// end delivers the GPU times of the last measured one.
-SceneResult measure(Pipeline& pipeline, std::size_t& counter, const std::string& scene,
-                    const std::vector<Frame>& frames, const LensSettings& lens, const QualitySettings& quality,
-                    const Options& options)
+/// One pipeline and its settings, measured side by side with others.
+struct Variant {
+    std::string scene; ///< the table's column
+    Pipeline* pipeline;
+    QualitySettings quality;
+};
+
+/// Runs `frames` (cycled) through each variant's pipeline, frame by frame alternating between
+/// them so that a slower or busier stretch of the machine falls on all of them alike:
+/// `options.warmup` frames unmeasured, then `options.runs` measured ones. GPU timer results
+/// arrive one frame late, tagged with the index of the frame they belong to, so every frame gets
+/// a unique index and one extra frame at the end delivers the GPU times of the last measured one.
+std::vector<SceneResult> measure(const std::vector<Variant>& variants, std::size_t& counter,
+                                 const std::vector<Frame>& frames, const LensSettings& lens, const Options& options)
 {
-    const auto runFrame = [&](int i) {
+    const auto runFrame = [&](const Variant& variant, int i) {
         Frame frame = frames[static_cast<std::size_t>(i) % frames.size()];
         frame.index = counter++;
-        pipeline.run(frame, lens, quality);
+        variant.pipeline->run(frame, lens, variant.quality);
         return frame.index;
     };
     for (int i = 0; i < options.warmup; ++i)
-        runFrame(i);
+        for (const Variant& variant : variants)
+            runFrame(variant, i);
 
-    SceneResult result{scene, {}, {}};
-    std::vector<double> gpuSum, depthPrep, analysis, upload, render, readback, total;
+    struct Collected {
+        SceneResult result;
+        std::vector<double> gpuSum, depthPrep, analysis, upload, render, readback, total;
+        double cpuSeconds = 0.0, othersSeconds = 0.0;
+    };
+    std::vector<Collected> collected(variants.size());
     const std::size_t firstMeasured = counter;
-    const CpuClock cpuStart = CpuClock::now();
-    const auto takeGpu = [&](const FrameTimings& t) {
+    const auto takeGpu = [&](Collected& c, const FrameTimings& t) {
         if (t.gpu.empty() || t.gpuFrame < firstMeasured)
             return;
         double sum = 0.0;
         for (const PassTime& pass : t.gpu) {
-            seriesNamed(result.gpu, pass.name, "GPU " + pass.name).ms.push_back(pass.ms);
+            seriesNamed(c.result.gpu, pass.name, "GPU " + pass.name).ms.push_back(pass.ms);
             sum += pass.ms;
         }
-        gpuSum.push_back(sum);
+        c.gpuSum.push_back(sum);
     };
-    for (int i = 0; i < options.runs; ++i) {
-        runFrame(options.warmup + i);
-        const FrameTimings& t = pipeline.timings();
-        takeGpu(t);
-        depthPrep.push_back(t.depthPrepMs);
-        analysis.push_back(t.analysisMs);
-        upload.push_back(t.uploadMs);
-        render.push_back(t.renderMs);
-        readback.push_back(t.readbackMs);
-        total.push_back(t.totalMs);
+    const CpuClock cpuStart = CpuClock::now();
+    for (int i = 0; i < options.runs; ++i)
+        for (std::size_t v = 0; v < variants.size(); ++v) {
+            runFrame(variants[v], options.warmup + i);
+            const FrameTimings& t = variants[v].pipeline->timings();
+            Collected& c = collected[v];
+            c.result.quarterFrames += variants[v].pipeline->plan().blurShift == 2 ? 1 : 0;
+            ++c.result.measuredFrames;
+            takeGpu(c, t);
+            c.depthPrep.push_back(t.depthPrepMs);
+            c.analysis.push_back(t.analysisMs);
+            c.upload.push_back(t.uploadMs);
+            c.render.push_back(t.renderMs);
+            c.readback.push_back(t.readbackMs);
+            c.total.push_back(t.totalMs);
+        }
+    const double othersShare = CpuClock::now().othersShareSince(cpuStart);
+    for (std::size_t v = 0; v < variants.size(); ++v) {
+        runFrame(variants[v], options.warmup + options.runs);
+        takeGpu(collected[v], variants[v].pipeline->timings());
     }
-    result.othersCpuShare = CpuClock::now().othersShareSince(cpuStart);
-    runFrame(options.warmup + options.runs);
-    takeGpu(pipeline.timings());
 
-    if (!gpuSum.empty())
-        result.gpu.push_back({"sum", "GPU sum of passes", gpuSum});
-    result.wall = {{"depthPrep", "depth prep (CPU)", depthPrep},
-                   {"analysis", "scene analysis (GPU)", analysis},
-                   {"upload", "upload (wall)", upload},
-                   {"renderSubmit", "render submit (wall)", render},
-                   {"readback", "readback (wall)", readback},
-                   {"total", "total per frame (wall)", total}};
-    return result;
+    std::vector<SceneResult> results;
+    for (std::size_t v = 0; v < variants.size(); ++v) {
+        Collected& c = collected[v];
+        SceneResult result = std::move(c.result);
+        result.scene = variants[v].scene;
+        result.othersCpuShare = othersShare;
+        if (!c.gpuSum.empty())
+            result.gpu.push_back({"sum", "GPU sum of passes", c.gpuSum});
+        result.wall = {{"depthPrep", "depth prep (CPU)", c.depthPrep},
+                       {"analysis", "scene analysis (GPU)", c.analysis},
+                       {"upload", "upload (wall)", c.upload},
+                       {"renderSubmit", "render submit (wall)", c.render},
+                       {"readback", "readback (wall)", c.readback},
+                       {"total", "total per frame (wall)", c.total}};
+        results.push_back(std::move(result));
+    }
+    return results;
 }
 
 /// Rows of both scenes side by side: label, then median and p90 of each scene.
@@ -356,6 +390,8 @@ int run(const Options& options, const std::string& commandLine)
 
     QualitySettings quality = toQuality(options.quality); // the preset under the options given
     quality.adaptive = !options.noAdaptive;
+    if (options.quarterOnLargeBlur)
+        quality.quarterOnLargeBlur = true;
     const std::string precision = quality.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
     LensSettings baseLens;
     baseLens.model = CocModel::ThinLens;
@@ -380,6 +416,16 @@ int run(const Options& options, const std::string& commandLine)
     auto context = gl::EglContext::create();
     const gl::ContextInfo& info = context.info();
     Pipeline pipeline(!options.noTimers);
+    pipeline.finishEachPass(options.finishEachPass);
+    std::optional<Pipeline> versusPipeline;
+    QualitySettings versusQuality = quality;
+    std::string versusScene;
+    if (options.versusHalfOnly) {
+        versusQuality.quarterOnLargeBlur = false;
+        versusPipeline.emplace(!options.noTimers);
+        versusPipeline->finishEachPass(options.finishEachPass);
+        versusScene = "half only";
+    }
 
     const unsigned cores = std::thread::hardware_concurrency();
     const std::string cpu = cpuModel();
@@ -391,17 +437,27 @@ int run(const Options& options, const std::string& commandLine)
     fmt::print("clip: {} ({} frames, cycled); --quality {}: {} {} taps{}, {} size, {}, {}; {} runs after {} warm-up "
                "frames per scene\n",
                options.data, clip.size(), options.qualityPreset, kernelName(quality.kernel), quality.samples,
-               quality.nearField ? " + near field" : "", resolutionName(quality.resolution),
+               quality.nearField ? " + near field" : "",
+               quality.resolution == Resolution::Half && quality.quarterOnLargeBlur ? "half (quarter on large blur)"
+                                                                                    : resolutionName(quality.resolution),
                precision == "32f" ? "RGBA32F" : "RGBA16F",
                quality.adaptive ? "adaptive (in-focus frames and tiles skipped)" : "every pass on every pixel",
                options.runs, options.warmup);
     fmt::print("lens: thin lens {} mm f/{} focused at {} m, 36 mm sensor, max-coc {} px per 640 px of width\n",
                options.focalLengthMm, options.fNumber, options.focusM, options.maxCocAt640);
-    fmt::print("GPU = GL_TIME_ELAPSED per pass{}; wall = CPU clock; readback waits for the GPU to finish.\n"
+    if (options.versusHalfOnly)
+        fmt::print("versus: the defocused scene also always at half size (no quarter size on large blur: the path "
+                   "before it), in a second pipeline, frames alternating between the two\n");
+    fmt::print("GPU = {}{}; wall = CPU clock; readback waits for the GPU to finish.\n"
                "Sizes other than the clip's are resized from it (aspect not kept); a row of n/a: the pass did "
                "not run.\nother processes' CPU %: share of all cores other programs used during the runs; "
                "above a few %, the figures are inflated.\n",
-               options.noTimers ? " (off: --no-timers)" : info.timerQueries ? "" : " (not offered by this driver: n/a)");
+               options.finishEachPass ? "wall ms per pass, glFinish before and after each (--finish-each-pass)"
+                                      : "GL_TIME_ELAPSED per pass",
+               options.finishEachPass ? ""
+               : options.noTimers     ? " (off: --no-timers)"
+               : info.timerQueries    ? ""
+                                      : " (not offered by this driver: n/a)");
     fmt::print("command: {}\n", commandLine);
 
     Json results = Json::array();
@@ -413,10 +469,13 @@ int run(const Options& options, const std::string& commandLine)
         const CocSpread spread = cocSpread(frames, lens);
 
         fmt::print(stderr, "defocus-bench: measuring {}x{}\n", size.width, size.height);
-        std::vector<SceneResult> scenes;
-        scenes.push_back(measure(pipeline, counter, "defocused", frames, lens, quality, options));
-        scenes.push_back(measure(pipeline, counter, "all in focus",
-                                 inFocusClip(frames, static_cast<float>(lens.focusM)), lens, quality, options));
+        std::vector<Variant> defocused{{"defocused", &pipeline, quality}};
+        if (versusPipeline)
+            defocused.push_back({versusScene, &*versusPipeline, versusQuality});
+        std::vector<SceneResult> scenes = measure(defocused, counter, frames, lens, options);
+        scenes.push_back(measure({{"all in focus", &pipeline, quality}}, counter,
+                                 inFocusClip(frames, static_cast<float>(lens.focusM)), lens, options)
+                             .front());
 
         fmt::print("\n{}x{}, max-coc {:.0f} px. CoC of the defocused scene: {:.0f}% sharp (<0.5 px), {:.0f}% near, "
                    "{:.0f}% far, {:.0f}% clamped; |CoC| median {:.1f} px, p90 {:.1f} px\n",
@@ -428,6 +487,13 @@ int run(const Options& options, const std::string& commandLine)
             others += scene.othersCpuShare < 0 ? fmt::format("{:>10}{:>10}", "n/a", "")
                                                : fmt::format("{:>10.0f}{:>10}", 100 * scene.othersCpuShare, "");
         fmt::print("{}\n", others);
+        std::string quarter = fmt::format("{:<26}", "frames at quarter size");
+        for (const SceneResult& scene : scenes)
+            quarter += fmt::format("{:>10}{:>10}", fmt::format("{}/{}", scene.quarterFrames, scene.measuredFrames), "");
+        fmt::print("{}\n", quarter);
+        if (versusPipeline)
+            fmt::print("{:<26}{:>10.3f}   (defocused / {}, medians of total per frame)\n", "ratio of frame times",
+                       median(scenes[0].wall.back().ms) / median(scenes[1].wall.back().ms), versusScene);
 
         for (const SceneResult& scene : scenes) {
             Json entry = {{"size", fmt::format("{}x{}", size.width, size.height)},
@@ -440,6 +506,7 @@ int run(const Options& options, const std::string& commandLine)
                                       {"farShare", spread.farShare},       {"clampedShare", spread.clampedShare},
                                       {"medianAbsPx", spread.medianAbsPx}, {"p90AbsPx", spread.p90AbsPx}};
             entry["othersCpuShare"] = scene.othersCpuShare;
+            entry["quarterSizeFrames"] = scene.quarterFrames;
             entry["gpuMs"] = seriesJson(scene.gpu);
             entry["wallMs"] = seriesJson(scene.wall);
             results.push_back(std::move(entry));
@@ -469,6 +536,9 @@ int run(const Options& options, const std::string& commandLine)
               {"resolution", resolutionName(quality.resolution)},
               {"precision", precision},
               {"adaptive", quality.adaptive},
+              {"finishEachPass", options.finishEachPass},
+              {"versusHalfOnly", options.versusHalfOnly},
+              {"quarterOnLargeBlur", quality.quarterOnLargeBlur},
               {"focusM", options.focusM},
               {"fNumber", options.fNumber},
               {"focalLengthMm", options.focalLengthMm},
@@ -582,6 +652,15 @@ int main(int argc, char** argv)
         ->check(CLI::Range(0, 1000))
         ->capture_default_str();
     cli::addQualityOptions(app, o.quality, o);
+    app.add_flag("--quarter-on-large-blur", o.quarterOnLargeBlur,
+                 "Half size goes to quarter size on frames whose blur is mostly beyond 32 px and that have no "
+                 "bokeh sprites (off in the presets: docs/benchmarks.md)");
+    app.add_flag("--versus-half-only", o.versusHalfOnly,
+                 "Also time the defocused scene always at half size (quarter size on large blur off: the path "
+                 "before it), frames alternating with the main settings', and print the ratio of frame times");
+    app.add_flag("--finish-each-pass", o.finishEachPass,
+                 "Profiling: glFinish before and after each pass, and wall ms per pass instead of timer queries "
+                 "(llvmpipe renders at a flush, so its queries need not fall on the pass that was issued)");
     app.add_option("--focus", o.focusM, "Distance in focus, metres")->capture_default_str();
     app.add_option("--f-number", o.fNumber, "Aperture as an f-number")->capture_default_str();
     app.add_option("--focal-length", o.focalLengthMm, "Focal length, millimetres")->capture_default_str();

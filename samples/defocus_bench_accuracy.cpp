@@ -817,7 +817,15 @@ int main(int argc, char** argv)
                    "scene folders only: folder of other tools' outputs, ANCHORS/SCENE/{blender-defocus,"
                    "gegl-lens-blur}.exr (scripts/corpus/anchors.py), measured beside the presets");
     std::string presetList;
-    app.add_option("--presets", presetList, "scene folders only: comma-separated presets to run (default: all)");
+    app.add_option("--presets", presetList,
+                   "scene folders only: comma-separated presets to run (default: all); NAME:quarter runs "
+                   "preset NAME with quarter size on large blur, NAME:half-only without (the presets' own), "
+                   "NAME:no-sprites without bokeh sprites (they combine: NAME:no-sprites:quarter)");
+    app.add_option("--scale", corpus.scale,
+                   "scene folders only: enlarge every scene by this factor (colour and truth bilinear, depth "
+                   "nearest, lens unchanged: the CoC in pixels grows with it), to judge large frames' blur")
+        ->check(CLI::Range(1, 8))
+        ->capture_default_str();
     app.add_flag("--missing-ok", corpus.missingOk,
                  "scene folders only: exit 77 (skipped) when a --scene folder does not exist");
     if (const auto status = cli::parse(app, argc, argv))

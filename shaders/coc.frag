@@ -11,11 +11,12 @@
 // Blender scene (rhombi-near, 6 taps, before the upscale prefilter was clamped): 33.10 dB,
 // against 33.01 for the top-left pixel's CoC (the nearest-neighbour resize of the depth), 33.02
 // for the nearest pixel's and 32.91 for the mean.
-// The last row and column repeat on frames of odd size. HIGHLIGHTS (with highlightGain > 1, or
-// bokeh sprites): the variant that treats highlights pixel by pixel before the mean. SPRITES
-// (bokeh sprites, highlightThreshold > 0): a pixel's light above the threshold leaves the gather
-// for its sprite; compiled out of the other variants, where llvmpipe would run it for every
-// pixel.
+// The last row and column repeat on frames of odd size. QUARTER_SIZE: the same over 4x4 pixels
+// (a quarter of the frame's size, CoC in quarter-size pixels), for frames whose blur is large
+// and that have no sprites. HIGHLIGHTS (with highlightGain > 1, or bokeh sprites): the variant
+// that treats highlights pixel by pixel before the mean. SPRITES (bokeh sprites,
+// highlightThreshold > 0): a pixel's light above the threshold leaves the gather for its sprite;
+// compiled out of the other variants, where llvmpipe would run it for every pixel.
 #include "common.glsl"
 #include "coc_params.glsl"
 #include "highlights.glsl"
@@ -60,7 +61,34 @@ float sharpest(vec4 c)
 void main()
 {
     const ivec2 texel = ivec2(gl_FragCoord.xy);
-#if defined(HALF_SIZE) && defined(HIGHLIGHTS)
+#if defined(QUARTER_SIZE) && defined(HIGHLIGHTS)
+    const ivec2 last = textureSize(uColor, 0) - 1;
+    vec3 sum = vec3(0.0);
+    float coc = 3.4e38;
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            const vec4 p = pixel(min(4 * texel + ivec2(i, j), last));
+            sum += p.rgb;
+            coc = abs(p.a) < abs(coc) ? p.a : coc;
+        }
+    outColor = vec4(sum * (1.0 / 16.0), 0.25 * coc);
+#elif defined(QUARTER_SIZE)
+    // Four bilinear fetches at the corners between 2x2 blocks, four gathers of their depths.
+    // A block past the frame's last row or column repeats it (the samplers clamp), as the
+    // half-size pass does.
+    const vec2 size = vec2(textureSize(uColor, 0));
+    vec3 sum = vec3(0.0);
+    float coc = 3.4e38;
+    for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+            const vec2 uv = vec2(4 * texel + 2 * ivec2(i, j) + 1) / size;
+            const vec4 z = textureGather(uDepth, uv, 0);
+            const float c = sharpest(vec4(signedCoc(z.x), signedCoc(z.y), signedCoc(z.z), signedCoc(z.w)));
+            coc = abs(c) < abs(coc) ? c : coc;
+            sum += textureLod(uColorSmooth, uv, 0.0).rgb;
+        }
+    outColor = vec4(sanitizeColor(0.25 * sum, largestColor), 0.25 * coc);
+#elif defined(HALF_SIZE) && defined(HIGHLIGHTS)
     // Highlight recovery needs each pixel's own colour and CoC.
     const ivec2 last = textureSize(uColor, 0) - 1;
     const ivec2 a = 2 * texel, b = min(a + 1, last);

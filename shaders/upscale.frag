@@ -1,6 +1,6 @@
 #version 450 core
-// Upscale (Resolution::Half): the frame-sized result from the half-size blur R of C (the CoC
-// pass's target), by way of upscale_prefilter.frag's S (R sharpened) and D = R - C. With bil()
+// Upscale (Resolution::Half): the frame-sized result from the half-size (or quarter-size: BLUR_SCALE
+// 0.25, DETAIL_BELOW_PX 4) blur R of C (the CoC pass's target), by way of upscale_prefilter.frag's S (R sharpened) and D = R - C. With bil()
 // the bilinear interpolation at the pixel's centre:
 //
 //   interpolated = bil(S)                      the blur, as sharp as the half size holds it
@@ -28,8 +28,9 @@ layout(binding = 3) uniform sampler2D uAdded;     // half size: D (bilinear)
 void main()
 {
     // Half-size texel i covers the frame's pixels 2i and 2i + 1, so its centre lies at 2i + 1:
-    // in the half-size texture's coordinates the pixel's centre is at half of its own.
-    const vec2 uv = gl_FragCoord.xy * 0.5 / vec2(textureSize(uSharpened, 0));
+    // in the half-size texture's coordinates the pixel's centre is at half of its own (a
+    // quarter at quarter size, BLUR_SCALE).
+    const vec2 uv = gl_FragCoord.xy * BLUR_SCALE / vec2(textureSize(uSharpened, 0));
     // S lies within its neighbourhood's range of the (non-negative) blur: so does its
     // interpolation.
     const vec3 interpolated = textureLod(uSharpened, uv, 0.0).rgb;

@@ -11,7 +11,7 @@ layout(std140, binding = 0) uniform ViewParams {
     int mode;        // 0 colour, 1 depth (red channel), 2 signed CoC (alpha channel)
     float rangeLow;  // depth: nearest metres on the scale; CoC: unused
     float rangeHigh; // depth: farthest metres; CoC: max CoC in pixels
-    int sourceShift; // 1: the source is half the target's size (Resolution::Half), else 0
+    int sourceShift; // log2 of the target's size over the source's: 1 half, 2 quarter (Resolution::Half)
 };
 
 // Five-key ramp from dark violet (near) through teal and green to yellow (far), in sRGB.

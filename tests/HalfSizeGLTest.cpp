@@ -1,5 +1,7 @@
 // Resolution::Half: the blurs at half size, the output at the frame's size with its in-focus
 // pixels kept (coc.frag HALF_SIZE, upscale_prefilter.frag, upscale.frag).
+#include <array>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -23,6 +25,13 @@ protected:
         q.samples = 6;
         q.targetFormat = TargetFormat::Rgba32F;
         q.resolution = resolution;
+        return q;
+    }
+    /// Half size with quarter size on large blur (off by default and in the presets).
+    static QualitySettings quarterOnLargeBlur()
+    {
+        QualitySettings q = quality(Resolution::Half);
+        q.quarterOnLargeBlur = true;
         return q;
     }
 
@@ -180,6 +189,93 @@ TEST(HalfSizePlan, DetailTilesAreTheTilesWithPixelsUnderTwoPixelsOfCoc)
     EXPECT_EQ(half.detailTiles[0], cv::Point(0, 0));
     EXPECT_EQ(half.detailTiles[1], cv::Point(1, 0));
     EXPECT_TRUE(makePlan(analysis, true, HexagonKernel::RhombiSum, Resolution::Full).detailTiles.empty());
+}
+
+TEST(HalfSizePlan, QuarterSizeWhenMoreThanATenthOfTheBlurredPixelsHaveAtLeast32PxOfCoc)
+{
+    // Defect caught: the wrong size chosen: quarter size for frames whose blur is small (at
+    // 640x480 with the defaults, which must keep their half-size output), or half size for
+    // those whose blur is large (1920x1080: the speed it buys); sharp pixels counted among the
+    // blurred ones; the rule applied with quarterOnLargeBlur off or at full size.
+    SceneAnalysis analysis;
+    analysis.tiles = {1, 1};
+    analysis.tileMinCoc = (cv::Mat_<float>(1, 1) << 0.0f);
+    analysis.tileMaxCoc = (cv::Mat_<float>(1, 1) << 40.0f);
+    analysis.tileNearDiameter = cv::Mat::zeros(1, 1, CV_32F);
+    analysis.maxCoc = 40.0f;
+    // Bins: < 0.5, < 1, < 2, < 4, < 8, < 16, < 32, < 64, the rest.
+    const auto shiftFor = [&](std::array<int, 9> histogram, bool quarter = true,
+                              Resolution resolution = Resolution::Half) {
+        analysis.histogram = histogram;
+        return makePlan(analysis, true, HexagonKernel::RhombiSum, resolution, 6, quarter).blurShift;
+    };
+    EXPECT_EQ(shiftFor({0, 0, 0, 0, 0, 0, 89, 11, 0}), 2);
+    EXPECT_EQ(shiftFor({0, 0, 0, 0, 0, 0, 89, 0, 11}), 2);   // the last bin counts too
+    EXPECT_EQ(shiftFor({0, 0, 0, 0, 0, 0, 90, 10, 0}), 1);   // a tenth is not more than a tenth
+    EXPECT_EQ(shiftFor({0, 0, 0, 0, 0, 0, 100, 0, 0}), 1);   // 16-32 px: the 640x480 defaults' range
+    EXPECT_EQ(shiftFor({900, 90, 0, 0, 0, 0, 0, 10, 0}), 2); // sharp pixels (< 1 px) are not counted
+    EXPECT_EQ(shiftFor({0, 0, 900, 0, 0, 0, 0, 10, 0}), 1);  // 1-2 px is blurred
+    EXPECT_EQ(shiftFor({0, 0, 0, 0, 0, 0, 0, 100, 0}, false), 1);
+    EXPECT_EQ(shiftFor({0, 0, 0, 0, 0, 0, 0, 100, 0}, true, Resolution::Full), 0);
+    // At quarter size the upscale keeps the frame's detail up to 4 px of CoC, so the tile
+    // (CoC 0..40 px) is a detail tile, and so is one whose least CoC is 3 px; one from 5 px is not.
+    analysis.histogram = {0, 0, 0, 0, 0, 0, 0, 100, 0};
+    EXPECT_EQ(makePlan(analysis, true, HexagonKernel::RhombiSum, Resolution::Half, 6, true).detailTiles.size(), 1u);
+    analysis.tileMinCoc.at<float>(0, 0) = 3.0f;
+    EXPECT_EQ(makePlan(analysis, true, HexagonKernel::RhombiSum, Resolution::Half, 6, true).detailTiles.size(), 1u);
+    analysis.tileMinCoc.at<float>(0, 0) = 5.0f;
+    EXPECT_TRUE(makePlan(analysis, true, HexagonKernel::RhombiSum, Resolution::Half, 6, true).detailTiles.empty());
+}
+
+TEST_F(HalfSize, LargeBlurRunsAtQuarterSizeAndKeepsTheInFocusPixels)
+{
+    // Textured noise, the left 48 columns in focus, the rest at 40 px of CoC: quarter size.
+    // Defects caught: the targets not a quarter of the frame (rounded up); in-focus pixels not
+    // put back (the upscale's detail limit left at half size's 2 px would still keep them, but
+    // an upscale that does not put the frame's pixels back, or samples D at the wrong place,
+    // changes them); the far part not blurred.
+    const Frame frame = textured({98, 66}, 48);
+    Pipeline pipeline;
+    const cv::Mat out = pipeline.run(frame, test::lensWithFarCoc(40.0), quarterOnLargeBlur());
+    EXPECT_EQ(pipeline.plan().blurShift, 2);
+    EXPECT_EQ(pipeline.readTarget(View::Input).size(), cv::Size(25, 17));
+    ASSERT_EQ(out.size(), frame.color.size());
+    // From four pixels (one quarter-size texel) away from the blurred part nothing may change.
+    cv::Mat sharp = cv::Mat::zeros(frame.color.size(), CV_8U);
+    sharp.colRange(0, 48 - 4).setTo(255);
+    cv::Mat diff, anyChannel;
+    cv::absdiff(out, frame.color, diff);
+    cv::transform(diff, anyChannel, cv::Matx13f(1, 1, 1));
+    EXPECT_EQ(cv::countNonZero(anyChannel & sharp), 0);
+    cv::Scalar mean, stddevIn, stddevOut;
+    cv::meanStdDev(frame.color.colRange(64, 98), mean, stddevIn);
+    cv::meanStdDev(out.colRange(64, 98), mean, stddevOut);
+    EXPECT_LT(stddevOut[0], stddevIn[0] / 3.0);
+}
+
+TEST_F(HalfSize, QuarterSizeBlurMatchesTheHalfSizeBlur)
+{
+    // Noise blurred by a 40-px hexagon, at quarter size (the plan's choice) and at half size
+    // (quarterOnLargeBlur off): what a clip shows when a frame crosses the rule. Defects caught:
+    // a quarter-size result out of place (the upscale's coordinates at half size's scale, or
+    // the CoC pass's blocks misaligned), or its CoC in the wrong unit (half-size pixels: a blur
+    // twice as large); each a seam in time where a clip switches between the sizes. Measured on
+    // llvmpipe: 0.42 8-bit levels of mean absolute difference; the upscale reading the quarter-
+    // size result at half size's coordinates 2.73, the CoC in half-size pixels 1.42. 1.0 catches
+    // both and leaves room for other drivers.
+    const Frame frame = textured({160, 128}, 0);
+    const LensSettings lens = test::lensWithFarCoc(40.0);
+    Pipeline quarterPipeline, halfPipeline;
+    const QualitySettings halfOnly = quality(Resolution::Half);
+    const cv::Mat quarter = quarterPipeline.run(frame, lens, quarterOnLargeBlur(), View::Composite, Encoding::Linear32F);
+    const cv::Mat half = halfPipeline.run(frame, lens, halfOnly, View::Composite, Encoding::Linear32F);
+    ASSERT_EQ(quarterPipeline.plan().blurShift, 2);
+    ASSERT_EQ(halfPipeline.plan().blurShift, 1);
+    const cv::Rect inside(24, 24, 112, 80); // away from the borders' mirroring
+    cv::Mat diff;
+    cv::absdiff(encodeSrgb(quarter(inside)), encodeSrgb(half(inside)), diff);
+    const cv::Scalar meanDiff = cv::mean(diff);
+    EXPECT_LT((meanDiff[0] + meanDiff[1] + meanDiff[2]) / 3.0, 1.0);
 }
 
 } // namespace

@@ -25,6 +25,15 @@ GpuTimer::GpuTimer(bool enabled) : enabled_(enabled)
 
 void GpuTimer::begin(const std::string& name)
 {
+    if (finish_) {
+        glFinish();
+        Set& set = sets_[current_];
+        if (set.used == set.scopes.size())
+            set.scopes.push_back({name, Handle<deleteQuery>(0)});
+        set.scopes[set.used].name = name;
+        started_ = std::chrono::steady_clock::now();
+        return;
+    }
     if (!enabled_)
         return;
     Set& set = sets_[current_];
@@ -33,12 +42,24 @@ void GpuTimer::begin(const std::string& name)
         glCreateQueries(GL_TIME_ELAPSED, 1, &id);
         set.scopes.push_back({name, Handle<deleteQuery>(id)});
     }
+    if (!set.scopes[set.used].query) { // made by a finishEachScope frame
+        GLuint id = 0;
+        glCreateQueries(GL_TIME_ELAPSED, 1, &id);
+        set.scopes[set.used].query = Handle<deleteQuery>(id);
+    }
     set.scopes[set.used].name = name;
+    set.scopes[set.used].wallMs = -1.0;
     glBeginQuery(GL_TIME_ELAPSED, set.scopes[set.used].query.id());
 }
 
 void GpuTimer::end()
 {
+    if (finish_) {
+        glFinish();
+        sets_[current_].scopes[sets_[current_].used++].wallMs =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started_).count();
+        return;
+    }
     if (!enabled_)
         return;
     glEndQuery(GL_TIME_ELAPSED);
@@ -50,7 +71,12 @@ GpuTimer::Results GpuTimer::read(Set& set)
     Results results;
     for (std::size_t i = 0; i < set.used; ++i) {
         GLuint64 ns = 0;
-        glGetQueryObjectui64v(set.scopes[i].query.id(), GL_QUERY_RESULT, &ns);
+        if (set.scopes[i].wallMs >= 0.0)
+            ns = static_cast<GLuint64>(set.scopes[i].wallMs * 1e6);
+        else if (set.scopes[i].query)
+            glGetQueryObjectui64v(set.scopes[i].query.id(), GL_QUERY_RESULT, &ns);
+        else
+            continue;
         // llvmpipe sometimes reports the time since boot for a scope (seen on the first scope of
         // every frame of `defocus --demo`, where the synthetic renderer's draws come between
         // frames; the cause is not found): a scope that long did not run that long, so it is

@@ -1,8 +1,11 @@
 // GPU time per pass from GL_TIME_ELAPSED queries, double-buffered: the results read after a
 // frame are those of the frame before, which the GPU has long finished, so reading them never
-// stalls the pipeline.
+// stalls the pipeline. With finishEachScope(true) (profiling), each scope instead waits for the
+// GPU at its start and end (glFinish) and reports the wall time in between: on llvmpipe, which
+// defers rendering to a flush, the queries' times need not fall where the passes were issued.
 #pragma once
 
+#include <chrono>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,6 +24,10 @@ public:
     /// Starts timing the scope `name` (scopes do not nest).
     void begin(const std::string& name);
     void end();
+    /// Profiling: glFinish around every scope, wall-clock times instead of queries. Slows the
+    /// frame (no overlap of CPU and GPU work), so for per-pass figures only.
+    void finishEachScope(bool on) { finish_ = on; }
+    bool finishesEachScope() const { return finish_; }
     /// Ends the current frame's set of scopes and returns the previous frame's results
     /// (empty after the first frame).
     Results swap();
@@ -32,6 +39,7 @@ private:
     struct Scope {
         std::string name;
         Handle<deleteQuery> query;
+        double wallMs = -1.0; ///< finishEachScope: measured on the CPU; -1: read the query
     };
     struct Set {
         std::vector<Scope> scopes; ///< pool, reused
@@ -40,6 +48,8 @@ private:
     Results read(Set& set);
 
     bool enabled_;
+    bool finish_ = false;
+    std::chrono::steady_clock::time_point started_;
     Set sets_[2];
     int current_ = 0;
 };

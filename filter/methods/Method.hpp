@@ -39,6 +39,9 @@ struct MethodSettings {
     /// every pass on every pixel, all-in-focus frames included. Ignored by the other methods,
     /// which always run every pass.
     bool adaptive = true;
+    /// The pipeline methods at half size: quarter size on frames whose blur is large
+    /// (QualitySettings::quarterOnLargeBlur); false: always half size.
+    bool quarterOnLargeBlur = false;
 };
 
 std::string_view precisionName(TargetFormat format);    ///< "16F", "32F"

@@ -29,6 +29,7 @@ QualitySettings PipelineMethod::quality(std::string_view name, const MethodSetti
     quality.resolution = settings.resolution;
     quality.adaptive = settings.adaptive;
     quality.highlightSprites = settings.highlightSprites;
+    quality.quarterOnLargeBlur = settings.quarterOnLargeBlur;
     return quality;
 }
 

@@ -49,6 +49,12 @@ const std::vector<Preset>& presets()
     // at the same accuracy (within 0.01 dB), half floats being converted in software on every
     // fetch and store. On a GPU 16F halves the bandwidth and will likely be the faster;
     // re-measure there.
+    //
+    // Quarter size on large blur (QualitySettings::quarterOnLargeBlur) stays off in fast and
+    // balanced: at 1920x1080 it took the balanced frame to 0.54 of its time, but on the corpus
+    // enlarged 3x (`defocus-bench accuracy --scale 3`, docs/benchmarks.md "Quarter size on large
+    // blur") it cost 0.38 dB in the median with sprites and 0.43 dB without, more than the 0.1 dB
+    // a preset may lose.
     static const std::vector<Preset> list{
         {"fast", "rhombi-near", {4, Resolution::Half, TargetFormat::Rgba32F}, 34.94, 20.7},
         {"balanced", "rhombi-near", {6, Resolution::Half, TargetFormat::Rgba32F}, 35.24, 20.6},

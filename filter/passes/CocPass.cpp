@@ -17,6 +17,9 @@ CocPass::CocPass()
       halfHighlightsProgram_("fullscreen.vert", "coc.frag", "coc half size highlights", {"HALF_SIZE 1", "HIGHLIGHTS 1"}),
       halfSpritesProgram_("fullscreen.vert", "coc.frag", "coc half size sprites",
                           {"HALF_SIZE 1", "HIGHLIGHTS 1", "SPRITES 1"}),
+      quarterProgram_("fullscreen.vert", "coc.frag", "coc quarter size", {"QUARTER_SIZE 1"}),
+      quarterHighlightsProgram_("fullscreen.vert", "coc.frag", "coc quarter size highlights",
+                                {"QUARTER_SIZE 1", "HIGHLIGHTS 1"}),
       uniforms_(sizeof(Uniforms), "coc params"),
       noSprites_(8 * sizeof(std::uint32_t), "coc: no sprites"),
       nearest_(GL_NEAREST, "coc nearest"),
@@ -51,7 +54,7 @@ CocPass::Uniforms CocPass::uniforms(const CocCoefficients& k, bool halfTarget, f
 }
 
 void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-                  const gl::Framebuffer& target, float highlightGain, bool halfSize, float highlightThreshold,
+                  const gl::Framebuffer& target, float highlightGain, int sizeShift, float highlightThreshold,
                   const gl::StorageBuffer* measurement, const gl::StorageBuffer* sprites)
 {
     assert(highlightThreshold <= 0.0f || (measurement && sprites));
@@ -62,12 +65,16 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocC
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     target.bindForDraw();
+    assert(sizeShift >= 0 && sizeShift <= 2);
     // Highlights are treated pixel by pixel: at half size, four fetches instead of one mean.
     const bool withSprites = highlightThreshold > 0.0f;
     const bool highlights = highlightGain > 1.0f || withSprites;
+    // Quarter size is chosen only on frames without sprites (makePlan()).
+    assert(sizeShift < 2 || !withSprites);
     const gl::Program& full = withSprites ? spritesProgram_ : program_;
     const gl::Program& half = withSprites ? halfSpritesProgram_ : highlights ? halfHighlightsProgram_ : halfProgram_;
-    (halfSize ? half : full).use();
+    const gl::Program& quarter = highlights ? quarterHighlightsProgram_ : quarterProgram_;
+    (sizeShift == 0 ? full : sizeShift == 1 ? half : quarter).use();
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
     bindTexture(2, color.id(), linear_.id());

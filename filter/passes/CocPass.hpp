@@ -1,5 +1,5 @@
 // Pass 1: linear colour + signed CoC (pixels) in alpha, into a float target of the frame's size
-// or half of it. Shader: coc.frag.
+// or half or a quarter of it. Shader: coc.frag.
 #pragma once
 
 #include "filter/Lens.hpp"
@@ -17,14 +17,14 @@ public:
     /// `color`: sRGB8 or float RGB; `depth`: R32F metres with no holes; `halfTarget` keeps HDR
     /// colour below the half-float maximum.
     /// `highlightGain` > 1 scales near-clipped pixels of 8-bit input that get blurred (coc.frag).
-    /// `halfSize`: the target is ((w + 1) / 2, (h + 1) / 2) and each texel averages 2x2 pixels,
-    /// its CoC in half-size pixels.
+    /// `sizeShift` 1: the target is ((w + 1) / 2, (h + 1) / 2) and each texel averages 2x2 pixels,
+    /// its CoC in half-size pixels; 2: ((w + 3) / 4, (h + 3) / 4), 4x4 pixels, quarter-size ones.
     /// `highlightThreshold` > 0: blurred pixels brighter than this that stand out of their tile
     /// keep only that much luminance (their rest goes to bokeh sprites, HighlightSpritePass);
     /// `measurement` is then the scene analysis' (SceneAnalysisPass::measurement()) and `sprites`
     /// the sprites found (HighlightSpritePass::sprites()), whose count says whether they fit.
     void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-             const gl::Framebuffer& target, float highlightGain = 1.0f, bool halfSize = false,
+             const gl::Framebuffer& target, float highlightGain = 1.0f, int sizeShift = 0,
              float highlightThreshold = 0.0f, const gl::StorageBuffer* measurement = nullptr,
              const gl::StorageBuffer* sprites = nullptr);
 
@@ -46,6 +46,7 @@ private:
     /// sprite share and its light's depth (coc.frag), compiled out of the others, since llvmpipe
     /// runs a branch's instructions even where no pixel takes it.
     gl::Program program_, spritesProgram_, halfProgram_, halfHighlightsProgram_, halfSpritesProgram_;
+    gl::Program quarterProgram_, quarterHighlightsProgram_; ///< QUARTER_SIZE: never with sprites (makePlan())
     gl::UniformBuffer uniforms_;
     gl::StorageBuffer noSprites_; ///< bound for the sprite count where there are no sprites
     gl::Sampler nearest_;

@@ -15,9 +15,10 @@ namespace defocus {
 
 namespace {
 
-std::vector<std::string> defines(bool interpolateOnly)
+std::vector<std::string> defines(int sizeShift, bool interpolateOnly)
 {
-    std::vector<std::string> list{fmt::format("DETAIL_BELOW_PX {:.6f}", kUpscaleDetailBelowPx)};
+    std::vector<std::string> list{fmt::format("DETAIL_BELOW_PX {:.6f}", upscaleDetailBelowPx(sizeShift)),
+                                  fmt::format("BLUR_SCALE {:.6f}", 1.0 / (1 << sizeShift))};
     if (interpolateOnly)
         list.emplace_back("INTERPOLATE_ONLY 1");
     return list;
@@ -25,10 +26,19 @@ std::vector<std::string> defines(bool interpolateOnly)
 
 } // namespace
 
+UpscalePass::Programs::Programs(int sizeShift)
+    : full("fullscreen.vert", "upscale.frag", sizeShift == 1 ? kName : "upscale quarter",
+           defines(sizeShift, false)),
+      detailTiles("tiles.vert", "upscale.frag", sizeShift == 1 ? "upscale detail tiles" : "upscale quarter detail tiles",
+                  defines(sizeShift, false)),
+      interpolateOnly("fullscreen.vert", "upscale.frag",
+                      sizeShift == 1 ? "upscale interpolate" : "upscale quarter interpolate", defines(sizeShift, true))
+{
+}
+
 UpscalePass::UpscalePass()
-    : program_("fullscreen.vert", "upscale.frag", kName, defines(false)),
-      detailTiles_("tiles.vert", "upscale.frag", "upscale detail tiles", defines(false)),
-      interpolateOnly_("fullscreen.vert", "upscale.frag", "upscale interpolate", defines(true)),
+    : half_(1),
+      quarter_(2),
       prefilter_("fullscreen.vert", "upscale_prefilter.frag", "upscale prefilter"),
       uniforms_(sizeof(CocPass::Uniforms), "upscale params"),
       nearest_(GL_NEAREST, "upscale nearest"),
@@ -45,8 +55,10 @@ void UpscalePass::prefilter(const Io& io)
     drawFullscreenTriangle();
 }
 
-void UpscalePass::upscale(const Io& io, const CocCoefficients& k, bool halfTarget, const TileList* detailTiles)
+void UpscalePass::upscale(const Io& io, const CocCoefficients& k, bool halfTarget, int sizeShift,
+                          const TileList* detailTiles)
 {
+    Programs& programs = sizeShift == 2 ? quarter_ : half_;
     const CocPass::Uniforms u = CocPass::uniforms(k, halfTarget, 1.0f);
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
@@ -56,14 +68,14 @@ void UpscalePass::upscale(const Io& io, const CocCoefficients& k, bool halfTarge
     bindTexture(2, io.sharpened.id(), linear_.id());
     bindTexture(3, io.added.id(), linear_.id());
     if (!detailTiles) {
-        program_.use();
+        programs.full.use();
         drawFullscreenTriangle();
         return;
     }
-    interpolateOnly_.use();
+    programs.interpolateOnly.use();
     drawFullscreenTriangle();
     if (detailTiles->count() > 0) {
-        detailTiles_.use();
+        programs.detailTiles.use();
         detailTiles->draw();
     }
 }

@@ -1,4 +1,4 @@
-// Upscale (Resolution::Half): the frame-sized result from the half-size blur, with the frame's
+// Upscale (Resolution::Half): the frame-sized result from the half- or quarter-size blur, with the frame's
 // own pixels put back where they are in focus. Two draws: the half-size prefilter that keeps the
 // interpolation sharp (upscale_prefilter.frag), then the frame-sized upscale (upscale.frag).
 #pragma once
@@ -36,12 +36,18 @@ public:
     /// The prefilter (half size, into io.prefiltered), then the upscale (into io.target); the
     /// pipeline times them apart.
     void prefilter(const Io& io);
-    void upscale(const Io& io, const CocCoefficients& k, bool halfTarget, const TileList* detailTiles = nullptr);
+    /// `sizeShift`: 1 when the blur ran at half size, 2 at quarter size.
+    void upscale(const Io& io, const CocCoefficients& k, bool halfTarget, int sizeShift,
+                 const TileList* detailTiles = nullptr);
 
 private:
-    gl::Program program_;          ///< the detail, full screen
-    gl::Program detailTiles_;      ///< the detail, tiles.vert
-    gl::Program interpolateOnly_;  ///< INTERPOLATE_ONLY, full screen
+    struct Programs {
+        gl::Program full;            ///< the detail, full screen
+        gl::Program detailTiles;     ///< the detail, tiles.vert
+        gl::Program interpolateOnly; ///< INTERPOLATE_ONLY, full screen
+        explicit Programs(int sizeShift);
+    };
+    Programs half_, quarter_;
     gl::Program prefilter_;
     gl::UniformBuffer uniforms_;
     gl::Sampler nearest_;

@@ -14,8 +14,11 @@ ViewPass::ViewPass()
 
 void ViewPass::run(const gl::Texture& source, Mode mode, float low, float high, const gl::Framebuffer& target)
 {
-    // A half-size target (Resolution::Half) is shown at the frame's size, each texel as 2x2.
-    const int shift = source.width() < target.width() ? 1 : 0;
+    // A half- or quarter-size target (Resolution::Half) is shown at the frame's size, each texel
+    // as 2x2 or 4x4.
+    int shift = 0;
+    while (shift < 2 && (source.width() << shift) < target.width())
+        ++shift;
     const Uniforms u{static_cast<int>(mode), low, high, shift};
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
