@@ -76,13 +76,20 @@ expect 75 "defocus-synthetic without GL" no_gl "$build/defocus-synthetic" -o "$s
 expect 75 "defocus-bench-accuracy without GL" no_gl "$build/defocus-bench-accuracy" --scene synthetic -o "$scratch/acc"
 
 # 130 and 143: Ctrl-C and SIGTERM while a clip plays (the preview, looping; defocus's own are in
-# CliGLTest, which also checks the video written so far).
+# CliGLTest, which also checks the video written so far). The signal goes once a frame was shown
+# (--trace prints each): a program started in the background by a non-interactive shell starts
+# with SIGINT ignored (POSIX), so a Ctrl-C sent before it installs its handler (a loaded machine
+# can take more than the 3 s this used to wait) is lost and the loop never ends.
 for signal in INT TERM; do
     want=130
     [ "$signal" = TERM ] && want=143
-    "$build/defocus-preview" "$data" --no-window --loop --no-pace -q >"$scratch/out" 2>"$scratch/err" &
+    "$build/defocus-preview" "$data" --no-window --loop --no-pace -q --trace >"$scratch/out" 2>"$scratch/err" &
     pid=$!
-    sleep 3
+    waited=0
+    while ! grep -q '^shown frame' "$scratch/out" 2>/dev/null && kill -0 "$pid" 2>/dev/null && [ $waited -lt 1200 ]; do
+        sleep 0.1
+        waited=$((waited + 1))
+    done
     kill -s "$signal" "$pid"
     wait "$pid"
     got=$?
