@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -104,10 +105,10 @@ std::size_t putLightEdgesAtTheirLightsDepth(const cv::Mat& colorLinear, cv::Mat&
 {
     CV_Assert(colorLinear.type() == CV_32FC3 && metres.type() == CV_32FC1 && colorLinear.size() == metres.size());
     const auto luminance = [](const cv::Vec3f& bgr) { return 0.0722f * bgr[0] + 0.7152f * bgr[1] + 0.2126f * bgr[2]; };
-    // Decided on the depth as it was: a changed pixel must not move its neighbours.
-    const cv::Mat before = metres.clone();
+    // Decided on the depth as it was: a changed pixel must not move its neighbours, so the
+    // changes (a light's edge pixels: few) are applied after the scan.
+    std::vector<std::pair<cv::Point, float>> changes;
     const int last = colorLinear.rows - 1, lastX = colorLinear.cols - 1;
-    std::size_t changed = 0;
     for (int y = 0; y <= last; ++y) {
         const auto* row = colorLinear.ptr<cv::Vec3f>(y);
         for (int x = 0; x <= lastX; ++x) {
@@ -122,14 +123,13 @@ std::size_t putLightEdgesAtTheirLightsDepth(const cv::Mat& colorLinear, cv::Mat&
                         brightest = b;
                         at = {qx, qy};
                     }
-            const float z = before.at<float>(at);
-            if (z < before.at<float>(y, x)) {
-                metres.at<float>(y, x) = z;
-                ++changed;
-            }
+            if (const float z = metres.at<float>(at); z < metres.at<float>(y, x))
+                changes.emplace_back(cv::Point{x, y}, z);
         }
     }
-    return changed;
+    for (const auto& [at, z] : changes)
+        metres.at<float>(at) = z;
+    return changes.size();
 }
 
 float centreDepth(const cv::Mat& depth, double windowFraction, float fallbackM)
