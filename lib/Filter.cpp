@@ -166,8 +166,8 @@ struct Filter::Impl {
 
     explicit Impl(gl::EglContext made) : context(std::move(made)) {}
 
-    /// report from the pipeline's last frame (frame number `frames`).
-    void fillReport();
+    /// report from the pipeline's last frame, frame number `index`.
+    void fillReport(std::size_t index);
 
     void bind()
     {
@@ -314,17 +314,16 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     cv::Mat out = p.pipeline->run(frame, lens, p.quality, toView(p.settings.view), encoding);
     p.lastFrame = std::move(frame);
     p.lastLens = lens;
-    p.fillReport();
-    ++p.frames;
+    p.fillReport(p.frames++);
     return out;
 }
 
-void Filter::Impl::fillReport()
+void Filter::Impl::fillReport(std::size_t index)
 {
     Impl& p = *this;
     const FrameTimings& t = p.pipeline->timings();
     FrameReport& r = p.report;
-    r.index = p.frames;
+    r.index = index;
     r.focusM = p.lastLens.focusM;
     r.timings.totalMs = t.totalMs;
     r.timings.depthPrepMs = t.depthPrepMs;
@@ -381,9 +380,7 @@ cv::Mat Filter::contactSheet()
     const Encoding encoding =
         p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
     pipeline.run(*p.lastFrame, p.lastLens, p.quality, toView(p.settings.view), encoding);
-    --p.frames;
-    p.fillReport();
-    ++p.frames;
+    p.fillReport(p.frames - 1);
     return sheet;
 }
 
