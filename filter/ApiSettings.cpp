@@ -1,6 +1,8 @@
 // The public settings as the pipeline's: filter/ApiSettings.hpp.
 #include "filter/ApiSettings.hpp"
 
+#include <iterator>
+
 #include "filter/methods/Presets.hpp"
 
 namespace defocus {
@@ -19,6 +21,22 @@ std::optional<Quality::Preset> parsePreset(std::string_view name)
     for (const auto preset : {Quality::Preset::Fast, Quality::Preset::Balanced, Quality::Preset::High})
         if (presetName(preset) == name)
             return preset;
+    return std::nullopt;
+}
+
+View toView(Settings::View view)
+{
+    return kAllViews[static_cast<int>(view)];
+}
+
+std::optional<Settings::View> parseApiView(std::string_view name)
+{
+    View view = View::Composite;
+    if (!parseView(name, view))
+        return std::nullopt;
+    for (int v = 0; v < static_cast<int>(std::size(kAllViews)); ++v)
+        if (kAllViews[v] == view)
+            return static_cast<Settings::View>(v);
     return std::nullopt;
 }
 

@@ -22,6 +22,11 @@ LensSettings toLens(const Lens& lens);
 /// The numbers of `in` back into `lens` (its model and field of view are kept).
 void fromLens(const LensSettings& in, Lens& lens);
 
+/// The pipeline's view for a public one (Settings::View lists them in kAllViews' order).
+View toView(Settings::View view);
+/// The public view called `name` as viewName() prints it ("composite", ...); nullopt for another.
+std::optional<Settings::View> parseApiView(std::string_view name);
+
 /// The preset's samples, precision, kernel, near field and resolution unless set, as the
 /// command line fills what its flags leave out; every other field as given.
 QualitySettings toQuality(const Quality& quality);

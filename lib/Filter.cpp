@@ -35,11 +35,6 @@ constexpr double kFallbackFrameS = 1.0 / 30.0;
 constexpr double kAutoWindow = 0.1;
 constexpr float kAutoFallbackM = 2.0f;
 
-View toView(Settings::View view)
-{
-    return kAllViews[static_cast<int>(view)];
-}
-
 template <typename T>
 void checkRange(std::vector<std::string>& issues, const char* parameter, T& value, T low, T high, bool clamp)
 {

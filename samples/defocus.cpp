@@ -13,7 +13,6 @@
 #include <csignal>
 #include <cmath>
 #include <cstdio>
-#include <iterator>
 #include <limits>
 #include <map>
 #include <string>
@@ -94,9 +93,6 @@ ContextOptions contextOptions(const Options& options)
     context.eglDevice = options.eglDevice;
     return context;
 }
-
-/// --view's names, in the order of Settings::View.
-constexpr const char* kViewNames[] = {"input", "horizontal", "diagonal-a", "diagonal-b", "composite", "depth", "coc"};
 
 int printInfo(const Options& options)
 {
@@ -466,7 +462,9 @@ void declareOptions(CLI::App& app, Options& o)
         ->capture_default_str();
     cli::addLensOptions(app, o.settings.lens, o, cli::FocalRange::Fixed);
     cli::addQualityOptions(app, o.settings.quality, o);
-    const std::vector<std::string> views(std::begin(kViewNames), std::end(kViewNames));
+    std::vector<std::string> views;
+    for (const View v : kAllViews)
+        views.emplace_back(viewName(v));
     app.add_option("--view", o.view, "What to write: " + fmt::format("{}", fmt::join(views, ", ")))
         ->check(CLI::IsMember(views))
         ->capture_default_str();
@@ -557,9 +555,7 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
     }
     cli::finishQuality(app, o, o.settings.quality);
     cli::finishLens(o, o.settings.lens);
-    for (std::size_t v = 0; v < std::size(kViewNames); ++v)
-        if (o.view == kViewNames[v])
-            o.settings.view = static_cast<Settings::View>(v);
+    o.settings.view = parseApiView(o.view).value_or(Settings::View::Composite); // checked by CLI11
     try {
         std::optional<cv::Point2d> point;
         if (!o.focusPoint.empty())
