@@ -112,6 +112,7 @@ struct Pipeline::Impl {
     ViewPass viewPass;
     TileList blurTiles, copyTiles, nearTiles;
     TileList detailTiles; ///< Resolution::Half: where the upscale puts the frame's detail back
+    TileList highlightTiles; ///< where the CoC pass treats highlights pixel by pixel
     bool upscaleUsesTiles = false;
     gl::GpuTimer timer;
 
@@ -478,13 +479,15 @@ void Pipeline::Impl::render()
     if (plan.highlightSprites)
         highlightSpritePass.find(colorTexture, depth, coefficients, static_cast<float>(plan.highlightGain),
                                  CocPass::largestColor(half), bladeRotationDeg, plan.nearField,
-                                 sceneAnalysisPass.measurement(),
+                                 sceneAnalysisPass.measurement(), analysis.highlightTiles,
                                  HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
                                                              analysis.highlightPixels));
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
+    if (plan.highlightSprites || plan.highlightGain > 1.0)
+        highlightTiles.set(analysis.highlightTiles, blurSize, tileSize());
     cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
                 blurShift, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
-                &sceneAnalysisPass.measurement(), &highlightSpritePass.sprites());
+                &sceneAnalysisPass.measurement(), &highlightSpritePass.sprites(), &highlightTiles);
     timer.end();
     rhombiSecondPending = false;
     if (quality.kernel == HexagonKernel::RhombiSum)

@@ -70,25 +70,26 @@ SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, 
         for (std::size_t bin = 0; bin < kBins; ++bin)
             m.histogram[bin] += band[bin];
 
-    // Highlights: 8-bit, any channel clipped (>= 250); float, luminance above 1. In bands too.
-    std::vector<int> bandBright(static_cast<std::size_t>(color.rows), 0);
-    cv::parallel_for_(cv::Range(0, color.rows), [&](const cv::Range& range) {
-        for (int y = range.start; y < range.end; ++y) {
-            int count = 0;
-            if (color.depth() == CV_8U) {
-                const std::uint8_t* p = color.ptr<std::uint8_t>(y);
-                for (int x = 0; x < color.cols; ++x, p += 3)
-                    count += std::max(p[0], std::max(p[1], p[2])) >= 250 ? 1 : 0;
-            } else {
-                const float* p = color.ptr<float>(y);
-                for (int x = 0; x < color.cols; ++x, p += 3) // BGR, Rec.709 luminance
-                    count += 0.0722f * p[0] + 0.7152f * p[1] + 0.2126f * p[2] > 1.0f ? 1 : 0;
+    // Highlights: 8-bit, any channel clipped (>= 250); float, luminance above 1. Per tile, in
+    // bands of tile rows too.
+    m.tileHighlights = cv::Mat::zeros(m.tiles, CV_32S);
+    cv::parallel_for_(cv::Range(0, m.tiles.height), [&](const cv::Range& range) {
+        for (int ty = range.start; ty < range.end; ++ty) {
+            int* counts = m.tileHighlights.ptr<int>(ty);
+            for (int y = ty * T; y < std::min((ty + 1) * T, color.rows); ++y) {
+                if (color.depth() == CV_8U) {
+                    const std::uint8_t* p = color.ptr<std::uint8_t>(y);
+                    for (int x = 0; x < color.cols; ++x, p += 3)
+                        counts[x / T] += std::max(p[0], std::max(p[1], p[2])) >= 250 ? 1 : 0;
+                } else {
+                    const float* p = color.ptr<float>(y);
+                    for (int x = 0; x < color.cols; ++x, p += 3) // BGR, Rec.709 luminance
+                        counts[x / T] += 0.0722f * p[0] + 0.7152f * p[1] + 0.2126f * p[2] > 1.0f ? 1 : 0;
+                }
             }
-            bandBright[static_cast<std::size_t>(y)] = count;
         }
     });
-    for (const int count : bandBright)
-        m.highlightPixels += static_cast<std::size_t>(count);
+    m.highlightPixels = static_cast<std::size_t>(cv::sum(m.tileHighlights)[0]);
     return m;
 }
 
@@ -125,6 +126,13 @@ SceneAnalysis finishAnalysis(const SceneMeasurement& m, const CocCoefficients& k
                    cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
     }
     a.highlightPixels = m.highlightPixels;
+    if (!m.tileHighlights.empty()) {
+        CV_Assert(m.tileHighlights.size() == m.tiles && m.tileHighlights.type() == CV_32SC1);
+        for (int ty = 0; ty < a.tiles.height; ++ty)
+            for (int tx = 0; tx < a.tiles.width; ++tx)
+                if (m.tileHighlights.at<int>(ty, tx) > 0)
+                    a.highlightTiles.emplace_back(tx, ty);
+    }
     a.highlightFraction = static_cast<double>(m.highlightPixels) / static_cast<double>(m.pixels);
     return a;
 }

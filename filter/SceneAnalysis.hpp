@@ -46,6 +46,10 @@ struct SceneAnalysis {
     cv::Mat tileNearDiameter;
     double highlightFraction = 0.0; ///< pixels above the highlight threshold
     std::size_t highlightPixels = 0; ///< the same, counted
+    /// The tiles (column, row) with a pixel above the highlight threshold: the only ones where
+    /// the CoC pass treats pixels one by one (highlight recovery, the bokeh sprites' share) and
+    /// where sprites are looked for.
+    std::vector<cv::Point> highlightTiles;
     double invalidDepthFraction = 0.0;
 
     /// Largest |CoC| of the frame.
@@ -63,6 +67,7 @@ struct SceneMeasurement {
     cv::Mat tileMaxDepth;
     std::array<int, SceneAnalysis::kHistogramEdges.size() + 1> histogram{}; ///< pixels per |CoC| bin
     std::size_t highlightPixels = 0; ///< 8-bit: any channel >= 250; float: luminance above 1
+    cv::Mat tileHighlights;          ///< CV_32SC1 per tile: its highlight pixels
     std::size_t pixels = 0;
 };
 

@@ -12,8 +12,6 @@
 #include "highlights.glsl"
 #include "hexagon_sprite.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
-
 layout(binding = 0) uniform sampler2D uColor; // sRGB8 textures decode to linear on fetch
 layout(binding = 1) uniform sampler2D uDepth; // metres, holes already filled
 
@@ -29,7 +27,13 @@ layout(std430, binding = 0) buffer Sprites {
     vec4 sprites[]; // per sprite: (x, y, signed CoC, hexagon's area), (light rgb, 0)
 };
 
+layout(std430, binding = 3) readonly buffer HighlightTiles {
+    ivec2 highlightTiles[]; // column, row
+};
+
 #ifdef SETTLE
+layout(local_size_x = 1) in;
+
 // One invocation after the search: a frame with more sprites than its budget draws none (the
 // CoC pass then leaves their light in the gather: coc.frag), so that the draw costs at most the
 // budget's hexagons whatever the picture.
@@ -39,9 +43,13 @@ void main()
         instanceCount = 0u;
 }
 #else
+// One work group per tile of the scene analysis that has pixels above the highlight threshold
+// (no other pixel can make a sprite: highlights.glsl), from the list the CPU made of them.
+layout(local_size_x = kTileSize, local_size_y = kTileSize) in;
+
 void main()
 {
-    const ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+    const ivec2 texel = highlightTiles[gl_WorkGroupID.x] * kTileSize + ivec2(gl_LocalInvocationID.xy);
     if (any(greaterThanEqual(texel, textureSize(uDepth, 0))))
         return;
     const vec3 raw = texelFetch(uColor, texel, 0).rgb;

@@ -1,6 +1,7 @@
 // Scene analysis on the GPU (scene_analysis.comp, SceneAnalysisPass) against the CPU's
 // measureScene(), which is the reference: the same tile depth ranges, histogram and highlights.
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -49,6 +50,10 @@ protected:
         // Highlights: the same pixels (8-bit: the sRGB decode's threshold sits between codes 249
         // and 250; float: the same luminance sum, so again only pixels at rounding distance).
         EXPECT_NEAR(static_cast<double>(gpu.highlightPixels), static_cast<double>(cpu.highlightPixels), 2.0);
+        // Per tile, the same (the tiles the sprites are looked for on and the CoC pass treats
+        // highlights on): catches the readback taking another word or tile.
+        ASSERT_EQ(gpu.tileHighlights.size(), cpu.tiles);
+        EXPECT_LE(cv::norm(gpu.tileHighlights, cpu.tileHighlights, cv::NORM_L1), 2.0);
     }
 };
 
@@ -88,6 +93,33 @@ TEST_F(SceneAnalysisGL, MatchesTheCpuOnAFrameOfOddSize)
     lens.focusM = 2.0;
     lens.fNumber = 1.0;
     expectSameMeasurement(color, depth, cocCoefficients(lens, color.cols));
+}
+
+TEST_F(SceneAnalysisGL, HighlightTilesAreTheTilesWithAPixelAboveWhite)
+{
+    // Catches a tile of the list at the wrong place (column and row swapped, another tile's
+    // count read back): the sprites would be looked for, and highlights treated by the CoC pass,
+    // where there are none, and a light left in the gather. 75 x 41 float: tiles 5 x 3, the last
+    // column and row partial; dark grey with lights at (3, 2), (17, 35) and (74, 40), and a pixel
+    // just below white (luminance 0.99) in tile (2, 0), which is not one.
+    cv::Mat color(41, 75, CV_32FC3, cv::Scalar::all(0.2));
+    color.at<cv::Vec3f>(2, 3) = cv::Vec3f(5.0f, 5.0f, 5.0f);
+    color.at<cv::Vec3f>(35, 17) = cv::Vec3f(0.0f, 3.0f, 0.0f);
+    color.at<cv::Vec3f>(40, 74) = cv::Vec3f(20.0f, 20.0f, 20.0f);
+    color.at<cv::Vec3f>(5, 40) = cv::Vec3f(0.99f, 0.99f, 0.99f);
+    const cv::Mat depth(color.size(), CV_32F, cv::Scalar(3.0));
+    LensSettings lens;
+    lens.focusM = 1.0;
+    const CocCoefficients k = cocCoefficients(lens, color.cols);
+    const std::vector<cv::Point> expected{{0, 0}, {1, 2}, {4, 2}};
+
+    gl::Texture colorTexture(GL_RGB32F, color.cols, color.rows, "test colour");
+    colorTexture.upload(GL_BGR, GL_FLOAT, color.data);
+    gl::Texture depthTexture(GL_R32F, color.cols, color.rows, "test depth");
+    depthTexture.upload(GL_RED, GL_FLOAT, depth.data);
+    SceneAnalysisPass pass;
+    EXPECT_EQ(finishAnalysis(pass.run(depthTexture, colorTexture, false, k), k, 0.0).highlightTiles, expected);
+    EXPECT_EQ(analyseScene(depth, color, k, 0.0).highlightTiles, expected);
 }
 
 TEST(ScenePlan, TapLoopsUnrollWhereMostLinesRunToTheLastTap)

@@ -12,13 +12,12 @@ namespace defocus {
 
 CocPass::CocPass()
     : program_("fullscreen.vert", "coc.frag", kName),
-      spritesProgram_("fullscreen.vert", "coc.frag", "coc sprites", {"SPRITES 1"}),
       halfProgram_("fullscreen.vert", "coc.frag", "coc half size", {"HALF_SIZE 1"}),
-      halfHighlightsProgram_("fullscreen.vert", "coc.frag", "coc half size highlights", {"HALF_SIZE 1", "HIGHLIGHTS 1"}),
-      halfSpritesProgram_("fullscreen.vert", "coc.frag", "coc half size sprites",
-                          {"HALF_SIZE 1", "HIGHLIGHTS 1", "SPRITES 1"}),
       quarterProgram_("fullscreen.vert", "coc.frag", "coc quarter size", {"QUARTER_SIZE 1"}),
-      quarterHighlightsProgram_("fullscreen.vert", "coc.frag", "coc quarter size highlights",
+      spritesProgram_("tiles.vert", "coc.frag", "coc sprites", {"SPRITES 1"}),
+      halfHighlightsProgram_("tiles.vert", "coc.frag", "coc half size highlights", {"HALF_SIZE 1", "HIGHLIGHTS 1"}),
+      halfSpritesProgram_("tiles.vert", "coc.frag", "coc half size sprites", {"HALF_SIZE 1", "HIGHLIGHTS 1", "SPRITES 1"}),
+      quarterHighlightsProgram_("tiles.vert", "coc.frag", "coc quarter size highlights",
                                 {"QUARTER_SIZE 1", "HIGHLIGHTS 1"}),
       uniforms_(sizeof(Uniforms), "coc params"),
       noSprites_(8 * sizeof(std::uint32_t), "coc: no sprites"),
@@ -55,7 +54,8 @@ CocPass::Uniforms CocPass::uniforms(const CocCoefficients& k, bool halfTarget, f
 
 void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
                   const gl::Framebuffer& target, float highlightGain, int sizeShift, float highlightThreshold,
-                  const gl::StorageBuffer* measurement, const gl::StorageBuffer* sprites)
+                  const gl::StorageBuffer* measurement, const gl::StorageBuffer* sprites,
+                  const TileList* highlightTiles)
 {
     assert(highlightThreshold <= 0.0f || (measurement && sprites));
     if (measurement)
@@ -66,19 +66,29 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocC
     uniforms_.bind(0);
     target.bindForDraw();
     assert(sizeShift >= 0 && sizeShift <= 2);
-    // Highlights are treated pixel by pixel: at half size, four fetches instead of one mean.
-    const bool withSprites = highlightThreshold > 0.0f;
-    const bool highlights = highlightGain > 1.0f || withSprites;
-    // Quarter size is chosen only on frames without sprites (makePlan()).
-    assert(sizeShift < 2 || !withSprites);
-    const gl::Program& full = withSprites ? spritesProgram_ : program_;
-    const gl::Program& half = withSprites ? halfSpritesProgram_ : highlights ? halfHighlightsProgram_ : halfProgram_;
-    const gl::Program& quarter = highlights ? quarterHighlightsProgram_ : quarterProgram_;
-    (sizeShift == 0 ? full : sizeShift == 1 ? half : quarter).use();
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
     bindTexture(2, color.id(), linear_.id());
+    (sizeShift == 0 ? program_ : sizeShift == 1 ? halfProgram_ : quarterProgram_).use();
     drawFullscreenTriangle();
+
+    // Highlights are treated pixel by pixel (at half size, four fetches instead of one mean),
+    // only on the tiles that have them: elsewhere recovery leaves a pixel as it is and no pixel is
+    // bright enough for a sprite, so the plain pass' texels stand (up to the rounding of their
+    // mean). At full size the plain pass recovers highlights itself.
+    const bool withSprites = highlightThreshold > 0.0f;
+    if (!withSprites && (highlightGain <= 1.0f || sizeShift == 0))
+        return;
+    assert(highlightTiles);
+    // Quarter size is chosen only on frames without sprites (makePlan()).
+    assert(sizeShift < 2 || !withSprites);
+    if (highlightTiles->count() == 0)
+        return;
+    (sizeShift == 0   ? spritesProgram_
+     : sizeShift == 1 ? (withSprites ? halfSpritesProgram_ : halfHighlightsProgram_)
+                      : quarterHighlightsProgram_)
+        .use();
+    highlightTiles->draw();
 }
 
 } // namespace defocus

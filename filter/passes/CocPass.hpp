@@ -5,6 +5,7 @@
 #include "filter/Lens.hpp"
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
+#include "filter/passes/TileList.hpp"
 
 namespace defocus {
 
@@ -23,10 +24,14 @@ public:
     /// keep only that much luminance (their rest goes to bokeh sprites, HighlightSpritePass);
     /// `measurement` is then the scene analysis' (SceneAnalysisPass::measurement()) and `sprites`
     /// the sprites found (HighlightSpritePass::sprites()), whose count says whether they fit.
+    /// Either of the two (or `sizeShift` > 0 with `highlightGain` > 1) needs `highlightTiles`,
+    /// the tiles of the target (SceneAnalysis::highlightTiles, 16 >> sizeShift texels a side)
+    /// that have pixels above the highlight threshold: the pass treats their pixels one by one,
+    /// after the plain pass over the whole target.
     void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
              const gl::Framebuffer& target, float highlightGain = 1.0f, int sizeShift = 0,
              float highlightThreshold = 0.0f, const gl::StorageBuffer* measurement = nullptr,
-             const gl::StorageBuffer* sprites = nullptr);
+             const gl::StorageBuffer* sprites = nullptr, const TileList* highlightTiles = nullptr);
 
     /// Mirrors the std140 block CocParams in coc_params.glsl (shared with upscale.frag).
     struct Uniforms {
@@ -42,11 +47,14 @@ public:
                              float highlightThreshold = 0.0f);
 
 private:
-    /// SPRITES: the variants for frames with bokeh sprites (highlightThreshold > 0): a pixel's
-    /// sprite share and its light's depth (coc.frag), compiled out of the others, since llvmpipe
-    /// runs a branch's instructions even where no pixel takes it.
-    gl::Program program_, spritesProgram_, halfProgram_, halfHighlightsProgram_, halfSpritesProgram_;
-    gl::Program quarterProgram_, quarterHighlightsProgram_; ///< QUARTER_SIZE: never with sprites (makePlan())
+    /// The plain variants, full-screen: every pixel of a frame without highlights, and the others'
+    /// pixels before their highlight tiles are drawn over.
+    gl::Program program_, halfProgram_, quarterProgram_;
+    /// On the highlight tiles (tiles.vert). HIGHLIGHTS: pixel by pixel before the mean. SPRITES:
+    /// for frames with bokeh sprites (highlightThreshold > 0), a pixel's sprite share (coc.frag),
+    /// compiled out of the others, since llvmpipe runs a branch's instructions even where no
+    /// pixel takes it. QUARTER_SIZE: never with sprites (makePlan()).
+    gl::Program spritesProgram_, halfHighlightsProgram_, halfSpritesProgram_, quarterHighlightsProgram_;
     gl::UniformBuffer uniforms_;
     gl::StorageBuffer noSprites_; ///< bound for the sprite count where there are no sprites
     gl::Sampler nearest_;

@@ -64,7 +64,8 @@ std::size_t HighlightSpritePass::budget(std::size_t pixels, std::size_t highligh
 
 void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k,
                                float highlightGain, float largestColor, float bladeRotationDeg, bool nearField,
-                               const gl::StorageBuffer& measurement, std::size_t budget)
+                               const gl::StorageBuffer& measurement, const std::vector<cv::Point>& tiles,
+                               std::size_t budget)
 {
     if (budget > capacity_) {
         capacity_ = std::bit_ceil(budget);
@@ -85,9 +86,18 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
     bindTexture(1, depth.id(), nearest_.id());
     updateSpriteParams(depth, bladeRotationDeg, nearField);
     spriteParams_.bind(1);
-    find_.use();
-    glDispatchCompute(static_cast<GLuint>((depth.width() + 7) / 8), static_cast<GLuint>((depth.height() + 7) / 8), 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    if (!tiles.empty()) {
+        static_assert(sizeof(cv::Point) == 2 * sizeof(std::int32_t));
+        const auto bytes = static_cast<GLsizeiptr>(tiles.size() * sizeof(cv::Point));
+        if (tiles_.size() < bytes)
+            tiles_ = gl::StorageBuffer(static_cast<GLsizeiptr>(std::bit_ceil(static_cast<std::size_t>(bytes))),
+                                       "highlight sprites: tiles searched");
+        tiles_.update(tiles.data(), bytes);
+        tiles_.bind(3);
+        find_.use();
+        glDispatchCompute(static_cast<GLuint>(tiles.size()), 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
     settle_.use();
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -5,6 +5,9 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
+
+#include <opencv2/core.hpp>
 
 #include "filter/Lens.hpp"
 #include "filter/gl/Objects.hpp"
@@ -28,10 +31,11 @@ public:
     /// (R32F metres, filled) with the CoC pass' settings (`k`, `highlightGain`, `largestColor`,
     /// the scene analysis' `measurement`) and the hexagon's (`bladeRotationDeg`, `nearField`), at
     /// most `budget` of them; a frame with more draws none, and the CoC pass (reading sprites())
-    /// then keeps all of their light.
+    /// then keeps all of their light. Only the 16x16 `tiles` (SceneAnalysis::highlightTiles) are
+    /// searched: no pixel elsewhere is bright enough.
     void find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, float highlightGain,
               float largestColor, float bladeRotationDeg, bool nearField, const gl::StorageBuffer& measurement,
-              std::size_t budget);
+              const std::vector<cv::Point>& tiles, std::size_t budget);
     /// Step 2: adds the sprites found to `target` (the frame's size, linear or sRGB with
     /// GL_FRAMEBUFFER_SRGB) where the gather would have spread their light (with the near field:
     /// foreground over what is behind it too), with find()'s settings; `depth` is find()'s. A
@@ -51,6 +55,7 @@ private:
     gl::Program find_, settle_, draw_;
     gl::UniformBuffer cocParams_, spriteParams_;
     gl::StorageBuffer sprites_;
+    gl::StorageBuffer tiles_; ///< the tiles searched, (column, row) as two ints each
     std::size_t capacity_ = 0; ///< sprites the buffer holds
     gl::Sampler nearest_;
 };

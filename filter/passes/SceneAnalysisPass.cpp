@@ -62,6 +62,7 @@ SceneMeasurement SceneAnalysisPass::run(const gl::Texture& depth, const gl::Text
     measurement_.read(words.data(), bytes);
     m.tileMinDepth.create(m.tiles, CV_32F);
     m.tileMaxDepth.create(m.tiles, CV_32F);
+    m.tileHighlights.create(m.tiles, CV_32S);
     std::array<std::size_t, kEdges> reach{};
     for (int y = 0; y < m.tiles.height; ++y)
         for (int x = 0; x < m.tiles.width; ++x) {
@@ -72,6 +73,7 @@ SceneMeasurement SceneAnalysisPass::run(const gl::Texture& depth, const gl::Text
             for (std::size_t i = 0; i < kEdges; ++i)
                 reach[i] += tile[kFirstReachWord + i];
             m.highlightPixels += tile[kHighlightsWord];
+            m.tileHighlights.at<int>(y, x) = static_cast<int>(tile[kHighlightsWord]);
             m.pixels += tile[kPixelsWord];
         }
     // Bin b holds the pixels that reach edge b - 1 but not edge b.
