@@ -20,7 +20,6 @@
 #include "filter/passes/HexBlurPass.hpp"
 #include "filter/passes/HighlightSpritePass.hpp"
 #include "filter/passes/RhombusBlurPass.hpp"
-#include "filter/passes/SceneAnalysisPass.hpp"
 #include "filter/passes/NearBlurPass.hpp"
 #include "filter/passes/UpscalePass.hpp"
 #include "filter/passes/ViewPass.hpp"
@@ -101,7 +100,6 @@ void validDepthRange(const cv::Mat& depth, float& lo, float& hi)
 struct Pipeline::Impl {
     gl::VertexArray vao = gl::VertexArray::create();
     CocPass cocPass;
-    SceneAnalysisPass sceneAnalysisPass;
     HighlightSpritePass highlightSpritePass;
     HexBlurPass hexBlurPass;
     RhombusBlurPass rhombusBlurPass;
@@ -113,6 +111,7 @@ struct Pipeline::Impl {
     TileList blurTiles, copyTiles, nearTiles;
     TileList detailTiles; ///< Resolution::Half: where the upscale puts the frame's detail back
     TileList highlightTiles; ///< where the CoC pass treats highlights pixel by pixel
+    gl::StorageBuffer neighbourhoods; ///< SceneAnalysis::tileNeighbourhood, for the bokeh sprites
     bool upscaleUsesTiles = false;
     gl::GpuTimer timer;
 
@@ -298,9 +297,7 @@ void Pipeline::Impl::prepareDepthAndPlan()
     depth.upload(GL_RED, GL_FLOAT, prepared.metres.data);
     timings.uploadMs = msSince(start);
 
-    // The analysis on the GPU, where the frame now is; the plan waits for its few kilobytes.
-    analysis = finishAnalysis(sceneAnalysisPass.run(depth, colorTexture, srgbInput, coefficients), coefficients,
-                              prepared.invalidFraction);
+    analysis = analyseScene(prepared.metres, color, coefficients, prepared.invalidFraction);
     const bool allInFocus = plan.allInFocus && quality.adaptive;
     plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples,
                     quality.quarterOnLargeBlur);
@@ -476,10 +473,17 @@ void Pipeline::Impl::render()
     timer.begin(CocPass::kName);
     // The bokeh sprites are found first (in the "coc" scope): the CoC pass leaves their light out
     // of the gather if they fit the frame's budget.
+    if (plan.highlightSprites) {
+        CV_Assert(analysis.tileNeighbourhood.type() == CV_32FC4 && analysis.tileNeighbourhood.isContinuous());
+        const auto bytes = static_cast<GLsizeiptr>(analysis.tileNeighbourhood.total() * sizeof(cv::Vec4f));
+        if (neighbourhoods.size() != bytes)
+            neighbourhoods = gl::StorageBuffer(bytes, "tile neighbourhoods");
+        neighbourhoods.update(analysis.tileNeighbourhood.data, bytes);
+    }
     if (plan.highlightSprites)
         highlightSpritePass.find(colorTexture, depth, coefficients, static_cast<float>(plan.highlightGain),
                                  CocPass::largestColor(half), bladeRotationDeg, plan.nearField,
-                                 sceneAnalysisPass.measurement(), analysis.highlightTiles,
+                                 neighbourhoods, analysis.highlightTiles,
                                  HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
                                                              analysis.highlightPixels));
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
@@ -487,7 +491,7 @@ void Pipeline::Impl::render()
         highlightTiles.set(analysis.highlightTiles, blurSize, tileSize());
     cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
                 blurShift, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
-                &sceneAnalysisPass.measurement(), &highlightSpritePass.sprites(), &highlightTiles);
+                &neighbourhoods, &highlightSpritePass.sprites(), &highlightTiles);
     timer.end();
     rhombiSecondPending = false;
     if (quality.kernel == HexagonKernel::RhombiSum)

@@ -1,6 +1,6 @@
 // The depth-of-field pipeline for one frame: a frame whose valid depths all give less than half a
 // pixel of CoC is passed through before anything else; otherwise depth hole filling, upload, the
-// scene analysis on the GPU and the per-frame plan (which tiles blur, which are copied, whether
+// scene analysis (CPU) and the per-frame plan (which tiles blur, which are copied, whether
 // the near field, highlights and sprites run), the CoC pass, the blurs (QualitySettings::kernel:
 // two passes of one-sided lines summed into three rhombi, the default, or McIntosh et al.'s three
 // directional blurs and the min() of two), at full or half size (half: a prefilter and an upscale
@@ -36,7 +36,7 @@ struct PassTime {
 /// queries (empty when the driver has none).
 struct FrameTimings {
     double depthPrepMs = 0.0; ///< resize + hole filling on the CPU
-    double analysisMs = 0.0;  ///< scene analysis (GPU, waited for) + plan (CPU)
+    double analysisMs = 0.0;  ///< scene analysis + plan (CPU)
     double uploadMs = 0.0;    ///< colour + depth to textures
     double renderMs = 0.0;    ///< submitting the passes
     double readbackMs = 0.0;  ///< output pass + glReadPixels (waits for the GPU)

@@ -1,5 +1,4 @@
-// Scene analysis: the CPU measurement (the GPU's reference, filter/passes/SceneAnalysisPass) and
-// what both share: the CoC ranges, the foreground's reach and the plan.
+// Scene analysis: the measurement of a frame, the CoC ranges, the foreground's reach and the plan.
 #include "filter/SceneAnalysis.hpp"
 
 #include <algorithm>
@@ -11,7 +10,40 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "filter/ColorSpace.hpp"
+
 namespace defocus {
+
+namespace {
+
+/// Rec. 709 luminance of linear BGR.
+float luminanceBgr(float b, float g, float r)
+{
+    return 0.0722f * b + 0.7152f * g + 0.2126f * r;
+}
+
+/// Per tile, the sums over the 3x3 tiles around it that lie in the frame: pixels, highlight
+/// pixels, luminance (SceneAnalysis::tileNeighbourhood).
+cv::Mat neighbourhoods(const SceneMeasurement& m, cv::Size frame)
+{
+    constexpr int T = SceneAnalysis::kTileSize;
+    cv::Mat out(m.tiles, CV_32FC4);
+    for (int ty = 0; ty < m.tiles.height; ++ty)
+        for (int tx = 0; tx < m.tiles.width; ++tx) {
+            cv::Vec4f sum(0.0f, 0.0f, 0.0f, 0.0f);
+            for (int y = std::max(ty - 1, 0); y <= std::min(ty + 1, m.tiles.height - 1); ++y)
+                for (int x = std::max(tx - 1, 0); x <= std::min(tx + 1, m.tiles.width - 1); ++x) {
+                    const int w = std::min(T, frame.width - x * T), h = std::min(T, frame.height - y * T);
+                    sum[0] += static_cast<float>(w * h);
+                    sum[1] += static_cast<float>(m.tileHighlights.at<int>(y, x));
+                    sum[2] += m.tileLuminance.at<float>(y, x);
+                }
+            out.at<cv::Vec4f>(ty, tx) = sum;
+        }
+    return out;
+}
+
+} // namespace
 
 float SceneAnalysis::maxAbsCoc() const
 {
@@ -30,6 +62,7 @@ SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, 
     SceneMeasurement m;
     constexpr int T = SceneAnalysis::kTileSize;
     m.tiles = {(filledDepth.cols + T - 1) / T, (filledDepth.rows + T - 1) / T};
+    m.frame = filledDepth.size();
     m.pixels = filledDepth.total();
 
     // Rows of tiles are independent: OpenCV's threads take them in bands, each band with its
@@ -70,21 +103,31 @@ SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, 
         for (std::size_t bin = 0; bin < kBins; ++bin)
             m.histogram[bin] += band[bin];
 
-    // Highlights: 8-bit, any channel clipped (>= 250); float, luminance above 1. Per tile, in
-    // bands of tile rows too.
+    // Highlights: 8-bit, any channel clipped (>= 250); float, luminance above 1. With the
+    // luminance summed (linear: 8-bit decoded from sRGB), per tile, in bands of tile rows too.
+    std::array<float, 256> decode{};
+    for (std::size_t i = 0; i < decode.size(); ++i)
+        decode[i] = srgbToLinear(static_cast<float>(i) / 255.0f);
     m.tileHighlights = cv::Mat::zeros(m.tiles, CV_32S);
+    m.tileLuminance = cv::Mat::zeros(m.tiles, CV_32F);
     cv::parallel_for_(cv::Range(0, m.tiles.height), [&](const cv::Range& range) {
         for (int ty = range.start; ty < range.end; ++ty) {
             int* counts = m.tileHighlights.ptr<int>(ty);
+            float* sums = m.tileLuminance.ptr<float>(ty);
             for (int y = ty * T; y < std::min((ty + 1) * T, color.rows); ++y) {
                 if (color.depth() == CV_8U) {
                     const std::uint8_t* p = color.ptr<std::uint8_t>(y);
-                    for (int x = 0; x < color.cols; ++x, p += 3)
+                    for (int x = 0; x < color.cols; ++x, p += 3) {
                         counts[x / T] += std::max(p[0], std::max(p[1], p[2])) >= 250 ? 1 : 0;
+                        sums[x / T] += luminanceBgr(decode[p[0]], decode[p[1]], decode[p[2]]);
+                    }
                 } else {
                     const float* p = color.ptr<float>(y);
-                    for (int x = 0; x < color.cols; ++x, p += 3) // BGR, Rec.709 luminance
-                        counts[x / T] += 0.0722f * p[0] + 0.7152f * p[1] + 0.2126f * p[2] > 1.0f ? 1 : 0;
+                    for (int x = 0; x < color.cols; ++x, p += 3) {
+                        const float brightness = luminanceBgr(p[0], p[1], p[2]);
+                        counts[x / T] += brightness > 1.0f ? 1 : 0;
+                        sums[x / T] += brightness;
+                    }
                 }
             }
         }
@@ -126,12 +169,14 @@ SceneAnalysis finishAnalysis(const SceneMeasurement& m, const CocCoefficients& k
                    cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
     }
     a.highlightPixels = m.highlightPixels;
-    if (!m.tileHighlights.empty()) {
-        CV_Assert(m.tileHighlights.size() == m.tiles && m.tileHighlights.type() == CV_32SC1);
+    if (m.highlightPixels > 0) {
+        CV_Assert(m.tileHighlights.size() == m.tiles && m.tileHighlights.type() == CV_32SC1 &&
+                  m.tileLuminance.size() == m.tiles && m.tileLuminance.type() == CV_32FC1);
         for (int ty = 0; ty < a.tiles.height; ++ty)
             for (int tx = 0; tx < a.tiles.width; ++tx)
                 if (m.tileHighlights.at<int>(ty, tx) > 0)
                     a.highlightTiles.emplace_back(tx, ty);
+        a.tileNeighbourhood = neighbourhoods(m, m.frame);
     }
     a.highlightFraction = static_cast<double>(m.highlightPixels) / static_cast<double>(m.pixels);
     return a;

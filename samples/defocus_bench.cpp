@@ -320,7 +320,7 @@ std::vector<SceneResult> measure(const std::vector<Variant>& variants, std::size
         if (!c.gpuSum.empty())
             result.gpu.push_back({"sum", "GPU sum of passes", c.gpuSum});
         result.wall = {{"depthPrep", "depth prep (CPU)", c.depthPrep},
-                       {"analysis", "scene analysis (GPU)", c.analysis},
+                       {"analysis", "scene analysis (CPU)", c.analysis},
                        {"upload", "upload (wall)", c.upload},
                        {"renderSubmit", "render submit (wall)", c.render},
                        {"readback", "readback (wall)", c.readback},

@@ -1,6 +1,5 @@
 // Highlights, shared by the CoC pass (coc.frag) and the bokeh sprites (highlight_sprites.comp);
 // needs coc_params.glsl and common.glsl.
-#include "scene_measurement.glsl"
 
 // Highlights from 8-bit video: a light clipped at 255 is far brighter than 1.0, and a
 // blur of its clipped value spreads a dull grey. Pixels whose brightest channel is within the
@@ -21,15 +20,17 @@ vec3 blurColor(vec3 color, float coc)
     return sanitizeColor(recoverHighlight(color, coc), largestColor);
 }
 
-// The scene analysis' measurement of the frame (scene_measurement.glsl).
-layout(std430, binding = 1) readonly buffer SceneMeasurement {
-    uint measurement[];
+// The neighbourhood a light is judged in: the 3x3 tiles of 16x16 px around the pixel's own
+// (48x48 px), clamped to the frame, summed on the CPU (SceneAnalysis::tileNeighbourhood): their
+// pixels, how many of them are above white, their luminance summed. One tile was too small for
+// the lights of the accuracy corpus: a light 10-15 px across fills most of its tile, and 64-84 %
+// of those scenes' light above white made no sprite (docs/accuracy.md).
+layout(std430, binding = 1) readonly buffer TileNeighbourhoods {
+    vec4 tileNeighbourhood[]; // rows of tiles top to bottom: pixels, highlights, luminance, 0
 };
 
-// The neighbourhood a light is judged in: the 3x3 tiles around the pixel's own (48x48 px),
-// clamped to the frame. One tile (16x16) was too small for the lights of the accuracy corpus:
-// a light 10-15 px across fills most of its tile, and 64-84 % of those scenes' light above
-// white made no sprite (docs/accuracy.md).
+const int kTileSize = 16; // SceneAnalysis::kTileSize
+
 struct Neighbourhood {
     float pixels;     // pixels in the tiles
     float highlights; // of them above white
@@ -38,20 +39,9 @@ struct Neighbourhood {
 
 Neighbourhood neighbourhood(ivec2 texel, ivec2 frameSize)
 {
-    const ivec2 tiles = (frameSize + kTileSize - 1) / kTileSize;
-    const ivec2 tile = texel / kTileSize;
-    Neighbourhood n = Neighbourhood(0.0, 0.0, 0.0);
-    for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-            const ivec2 t = tile + ivec2(dx, dy);
-            if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, tiles)))
-                continue;
-            const int base = kMeasurementWords * (t.y * tiles.x + t.x);
-            n.pixels += float(measurement[base + kPixelsWord]);
-            n.highlights += float(measurement[base + kHighlightsWord]);
-            n.luminance += uintBitsToFloat(measurement[base + kLuminanceWord]);
-        }
-    return n;
+    const int tilesX = (frameSize.x + kTileSize - 1) / kTileSize;
+    const vec4 n = tileNeighbourhood[(texel.y / kTileSize) * tilesX + texel.x / kTileSize];
+    return Neighbourhood(n.x, n.y, n.z);
 }
 
 // A neighbourhood's pixels become sprites only where at most this share of them is above white:

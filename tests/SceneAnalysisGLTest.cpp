@@ -1,107 +1,20 @@
-// Scene analysis on the GPU (scene_analysis.comp, SceneAnalysisPass) against the CPU's
-// measureScene(), which is the reference: the same tile depth ranges, histogram and highlights.
-#include <string>
+// The scene analysis (filter/SceneAnalysis): the tiles with highlights and the neighbourhoods the
+// bokeh sprites judge lights in, and the plan's tap loops.
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core.hpp>
 
-#include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
 #include "filter/SceneAnalysis.hpp"
-#include "filter/methods/Method.hpp"
-#include "filter/passes/SceneAnalysisPass.hpp"
-#include "sources/ImageIO.hpp"
-#include "tests/GLTestSupport.hpp"
-#include "tests/TestSupport.hpp"
 
 namespace defocus {
 namespace {
 
-class SceneAnalysisGL : public test::GLTest {
-protected:
-    /// Measures `color` (CV_8UC3 or CV_32FC3) and its filled depth on the GPU and on the CPU and
-    /// compares them.
-    static void expectSameMeasurement(const cv::Mat& color, const cv::Mat& filledDepth, const CocCoefficients& k)
-    {
-        const bool eightBit = color.type() == CV_8UC3;
-        gl::Texture colorTexture(eightBit ? GL_SRGB8 : GL_RGB32F, color.cols, color.rows, "test colour");
-        colorTexture.upload(GL_BGR, eightBit ? GL_UNSIGNED_BYTE : GL_FLOAT, color.data);
-        gl::Texture depth(GL_R32F, color.cols, color.rows, "test depth");
-        depth.upload(GL_RED, GL_FLOAT, filledDepth.data);
-        SceneAnalysisPass pass;
-        const SceneMeasurement gpu = pass.run(depth, colorTexture, eightBit, k);
-        const SceneMeasurement cpu = measureScene(filledDepth, color, k);
-
-        ASSERT_EQ(gpu.tiles, cpu.tiles);
-        EXPECT_EQ(gpu.pixels, cpu.pixels);
-        // Minimum and maximum pick one of the pixels' own values: exactly equal.
-        EXPECT_EQ(cv::norm(gpu.tileMinDepth, cpu.tileMinDepth, cv::NORM_INF), 0.0);
-        EXPECT_EQ(cv::norm(gpu.tileMaxDepth, cpu.tileMaxDepth, cv::NORM_INF), 0.0);
-        // The histogram: the GPU may fuse the CoC's multiply-add, so a pixel within a float
-        // rounding of a bin edge can land in the next bin; a few pixels in a frame at most.
-        int total = 0, moved = 0;
-        for (std::size_t bin = 0; bin < cpu.histogram.size(); ++bin) {
-            total += gpu.histogram[bin];
-            moved += std::abs(gpu.histogram[bin] - cpu.histogram[bin]);
-        }
-        EXPECT_EQ(total, static_cast<int>(cpu.pixels));
-        EXPECT_LE(moved, 4) << "pixels in another |CoC| bin than on the CPU";
-        // Highlights: the same pixels (8-bit: the sRGB decode's threshold sits between codes 249
-        // and 250; float: the same luminance sum, so again only pixels at rounding distance).
-        EXPECT_NEAR(static_cast<double>(gpu.highlightPixels), static_cast<double>(cpu.highlightPixels), 2.0);
-        // Per tile, the same (the tiles the sprites are looked for on and the CoC pass treats
-        // highlights on): catches the readback taking another word or tile.
-        ASSERT_EQ(gpu.tileHighlights.size(), cpu.tiles);
-        EXPECT_LE(cv::norm(gpu.tileHighlights, cpu.tileHighlights, cv::NORM_L1), 2.0);
-    }
-};
-
-TEST_F(SceneAnalysisGL, MatchesTheCpuOnARecordedFrame)
+/// 75 x 41 float (tiles 5 x 3, the last column and row partial), dark grey with lights at
+/// (3, 2), (17, 35) and (74, 40), and a pixel just below white (luminance 0.99) in tile (2, 0).
+SceneAnalysis analyseLights()
 {
-    // The TUM clip's first frame: 8-bit colour, a quarter of its depth holes (filled first).
-    const auto dir = test::dataDir() / "tum_fr1_rpy";
-    const cv::Mat color = readColor(dir / "rgb/1305031250.261917.png");
-    const cv::Mat raw = readDepth(dir / "depth/1305031250.253735.png", 5000.0);
-    const PreparedDepth depth = prepareDepth(raw, color.size(), 1.0f);
-    LensSettings lens;
-    lens.fNumber = 1.4;
-    lens.focusM = 1.0;
-    expectSameMeasurement(color, depth.metres, cocCoefficients(lens, color.cols));
-}
-
-TEST_F(SceneAnalysisGL, MatchesTheCpuOnHdrInputWithHighlights)
-{
-    // The Blender scene: float colour with lights up to 80, near and far blur.
-    const auto dir = test::dataDir() / "blender_spheres";
-    const cv::Mat color = readColor(dir / "color_linear.exr");
-    const cv::Mat depth = readDepth(dir / "depth.exr", 1000.0);
-    const SceneMeasurement cpu = measureScene(depth, color, cocCoefficients(blenderSpheresLens(), color.cols));
-    ASSERT_GT(cpu.highlightPixels, 0u);
-    expectSameMeasurement(color, depth, cocCoefficients(blenderSpheresLens(), color.cols));
-}
-
-TEST_F(SceneAnalysisGL, MatchesTheCpuOnAFrameOfOddSize)
-{
-    // 75 x 41: partial tiles on the right and at the bottom; random depths 0.3-20 m and
-    // clipped pixels here and there.
-    cv::RNG rng(7);
-    cv::Mat color(41, 75, CV_8UC3), depth(41, 75, CV_32F);
-    rng.fill(color, cv::RNG::UNIFORM, 0, 256);
-    rng.fill(depth, cv::RNG::UNIFORM, 0.3, 20.0);
-    LensSettings lens;
-    lens.focusM = 2.0;
-    lens.fNumber = 1.0;
-    expectSameMeasurement(color, depth, cocCoefficients(lens, color.cols));
-}
-
-TEST_F(SceneAnalysisGL, HighlightTilesAreTheTilesWithAPixelAboveWhite)
-{
-    // Catches a tile of the list at the wrong place (column and row swapped, another tile's
-    // count read back): the sprites would be looked for, and highlights treated by the CoC pass,
-    // where there are none, and a light left in the gather. 75 x 41 float: tiles 5 x 3, the last
-    // column and row partial; dark grey with lights at (3, 2), (17, 35) and (74, 40), and a pixel
-    // just below white (luminance 0.99) in tile (2, 0), which is not one.
     cv::Mat color(41, 75, CV_32FC3, cv::Scalar::all(0.2));
     color.at<cv::Vec3f>(2, 3) = cv::Vec3f(5.0f, 5.0f, 5.0f);
     color.at<cv::Vec3f>(35, 17) = cv::Vec3f(0.0f, 3.0f, 0.0f);
@@ -110,16 +23,45 @@ TEST_F(SceneAnalysisGL, HighlightTilesAreTheTilesWithAPixelAboveWhite)
     const cv::Mat depth(color.size(), CV_32F, cv::Scalar(3.0));
     LensSettings lens;
     lens.focusM = 1.0;
-    const CocCoefficients k = cocCoefficients(lens, color.cols);
-    const std::vector<cv::Point> expected{{0, 0}, {1, 2}, {4, 2}};
+    return analyseScene(depth, color, cocCoefficients(lens, color.cols), 0.0);
+}
 
-    gl::Texture colorTexture(GL_RGB32F, color.cols, color.rows, "test colour");
-    colorTexture.upload(GL_BGR, GL_FLOAT, color.data);
-    gl::Texture depthTexture(GL_R32F, color.cols, color.rows, "test depth");
-    depthTexture.upload(GL_RED, GL_FLOAT, depth.data);
-    SceneAnalysisPass pass;
-    EXPECT_EQ(finishAnalysis(pass.run(depthTexture, colorTexture, false, k), k, 0.0).highlightTiles, expected);
-    EXPECT_EQ(analyseScene(depth, color, k, 0.0).highlightTiles, expected);
+TEST(SceneAnalysisHighlights, HighlightTilesAreTheTilesWithAPixelAboveWhite)
+{
+    // Catches a tile of the list at the wrong place (column and row swapped, another tile's
+    // count): the sprites would be looked for, and highlights treated by the CoC pass, where
+    // there are none, and a light left in the gather. The pixel below white makes no tile.
+    const std::vector<cv::Point> expected{{0, 0}, {1, 2}, {4, 2}};
+    EXPECT_EQ(analyseLights().highlightTiles, expected);
+}
+
+TEST(SceneAnalysisHighlights, NeighbourhoodsSumTheTilesAroundInTheFrame)
+{
+    // Catches a neighbourhood of the wrong tiles or sizes (its own tile alone, tiles past the
+    // frame's edge counted, partial tiles counted whole): a light is judged against the mean of
+    // the wrong pixels and loses its sprite or gets one as part of a bright surface.
+    const SceneAnalysis a = analyseLights();
+    ASSERT_EQ(a.tileNeighbourhood.size(), cv::Size(5, 3));
+    ASSERT_EQ(a.tileNeighbourhood.type(), CV_32FC4);
+    const auto luminance = [](float b, float g, float r) { return 0.0722f * b + 0.7152f * g + 0.2126f * r; };
+    const float grey = luminance(0.2f, 0.2f, 0.2f);
+    // Tile (0, 0): tiles (0..1, 0..1), 32 x 32 px, one light (5, 5, 5) among them.
+    const cv::Vec4f corner = a.tileNeighbourhood.at<cv::Vec4f>(0, 0);
+    EXPECT_EQ(corner[0], 1024.0f);
+    EXPECT_EQ(corner[1], 1.0f);
+    EXPECT_NEAR(corner[2], 1023.0f * grey + 5.0f, 1e-2);
+    // Tile (4, 2), the partial corner: tiles (3..4, 1..2), 16 + 11 px wide and 16 + 9 px high;
+    // the light at (74, 40) only.
+    const cv::Vec4f last = a.tileNeighbourhood.at<cv::Vec4f>(2, 4);
+    EXPECT_EQ(last[0], 27.0f * 25.0f);
+    EXPECT_EQ(last[1], 1.0f);
+    EXPECT_NEAR(last[2], (27.0f * 25.0f - 1.0f) * grey + 20.0f, 1e-2);
+    // Tile (2, 1), the middle: all nine tiles but the partial column 4, 48 x 41 px, with the
+    // light at (17, 35), the pixel below white and (74, 40)'s column outside.
+    const cv::Vec4f middle = a.tileNeighbourhood.at<cv::Vec4f>(1, 2);
+    EXPECT_EQ(middle[0], 48.0f * 41.0f);
+    EXPECT_EQ(middle[1], 1.0f);
+    EXPECT_NEAR(middle[2], (48.0f * 41.0f - 2.0f) * grey + luminance(0.0f, 3.0f, 0.0f) + 0.99f, 1e-2);
 }
 
 TEST(ScenePlan, TapLoopsUnrollWhereMostLinesRunToTheLastTap)

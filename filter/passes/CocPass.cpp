@@ -54,12 +54,12 @@ CocPass::Uniforms CocPass::uniforms(const CocCoefficients& k, bool halfTarget, f
 
 void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
                   const gl::Framebuffer& target, float highlightGain, int sizeShift, float highlightThreshold,
-                  const gl::StorageBuffer* measurement, const gl::StorageBuffer* sprites,
+                  const gl::StorageBuffer* neighbourhoods, const gl::StorageBuffer* sprites,
                   const TileList* highlightTiles)
 {
-    assert(highlightThreshold <= 0.0f || (measurement && sprites));
-    if (measurement)
-        measurement->bind(1);
+    assert(highlightThreshold <= 0.0f || (neighbourhoods && sprites));
+    if (neighbourhoods)
+        neighbourhoods->bind(1);
     (sprites ? *sprites : noSprites_).bind(2);
     const Uniforms u = uniforms(k, halfTarget, highlightGain, highlightThreshold);
     uniforms_.update(&u, sizeof u);

@@ -22,7 +22,7 @@ public:
     /// its CoC in half-size pixels; 2: ((w + 3) / 4, (h + 3) / 4), 4x4 pixels, quarter-size ones.
     /// `highlightThreshold` > 0: blurred pixels brighter than this that stand out of their tile
     /// keep only that much luminance (their rest goes to bokeh sprites, HighlightSpritePass);
-    /// `measurement` is then the scene analysis' (SceneAnalysisPass::measurement()) and `sprites`
+    /// `neighbourhoods` then holds SceneAnalysis::tileNeighbourhood (highlights.glsl) and `sprites`
     /// the sprites found (HighlightSpritePass::sprites()), whose count says whether they fit.
     /// Either of the two (or `sizeShift` > 0 with `highlightGain` > 1) needs `highlightTiles`,
     /// the tiles of the target (SceneAnalysis::highlightTiles, 16 >> sizeShift texels a side)
@@ -30,7 +30,7 @@ public:
     /// after the plain pass over the whole target.
     void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
              const gl::Framebuffer& target, float highlightGain = 1.0f, int sizeShift = 0,
-             float highlightThreshold = 0.0f, const gl::StorageBuffer* measurement = nullptr,
+             float highlightThreshold = 0.0f, const gl::StorageBuffer* neighbourhoods = nullptr,
              const gl::StorageBuffer* sprites = nullptr, const TileList* highlightTiles = nullptr);
 
     /// Mirrors the std140 block CocParams in coc_params.glsl (shared with upscale.frag).

@@ -64,7 +64,7 @@ std::size_t HighlightSpritePass::budget(std::size_t pixels, std::size_t highligh
 
 void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k,
                                float highlightGain, float largestColor, float bladeRotationDeg, bool nearField,
-                               const gl::StorageBuffer& measurement, const std::vector<cv::Point>& tiles,
+                               const gl::StorageBuffer& neighbourhoods, const std::vector<cv::Point>& tiles,
                                std::size_t budget)
 {
     if (budget > capacity_) {
@@ -81,7 +81,7 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
     cocParams_.update(&u, sizeof u);
     cocParams_.bind(0);
     sprites_.bind(0);
-    measurement.bind(1);
+    neighbourhoods.bind(1);
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
     updateSpriteParams(depth, bladeRotationDeg, nearField);

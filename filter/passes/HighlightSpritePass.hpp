@@ -29,12 +29,12 @@ public:
     HighlightSpritePass();
     /// Step 1, before the CoC pass: finds the sprites in `color` (sRGB8 or float RGB) and `depth`
     /// (R32F metres, filled) with the CoC pass' settings (`k`, `highlightGain`, `largestColor`,
-    /// the scene analysis' `measurement`) and the hexagon's (`bladeRotationDeg`, `nearField`), at
+    /// the tiles' `neighbourhoods`, SceneAnalysis::tileNeighbourhood) and the hexagon's (`bladeRotationDeg`, `nearField`), at
     /// most `budget` of them; a frame with more draws none, and the CoC pass (reading sprites())
     /// then keeps all of their light. Only the 16x16 `tiles` (SceneAnalysis::highlightTiles) are
     /// searched: no pixel elsewhere is bright enough.
     void find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, float highlightGain,
-              float largestColor, float bladeRotationDeg, bool nearField, const gl::StorageBuffer& measurement,
+              float largestColor, float bladeRotationDeg, bool nearField, const gl::StorageBuffer& neighbourhoods,
               const std::vector<cv::Point>& tiles, std::size_t budget);
     /// Step 2: adds the sprites found to `target` (the frame's size, linear or sRGB with
     /// GL_FRAMEBUFFER_SRGB) where the gather would have spread their light (with the near field:

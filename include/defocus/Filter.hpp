@@ -53,7 +53,7 @@ public:
 struct Timings {
     double totalMs = 0.0;     ///< process(), wall clock
     double depthPrepMs = 0.0; ///< depth resized to the colour and its holes filled (CPU)
-    double analysisMs = 0.0;  ///< scene analysis (GPU) and the plan (CPU)
+    double analysisMs = 0.0;  ///< scene analysis and the plan (CPU)
     double uploadMs = 0.0;    ///< colour and depth to the GPU
     double renderMs = 0.0;    ///< submitting the passes
     double readbackMs = 0.0;  ///< the output pass and reading the result back
