@@ -195,8 +195,13 @@ TEST_F(HighlightSprites, ALightInFrontOfABlurredBackgroundIsNotDrawnASecondTimeB
             // The second hexagon held 52-70 % of the light in focus and 18 % with the edge at the
             // background's depth. Below a tenth: the rule keeps white's worth of such a light in
             // the gather (a faint halo, as for any colour up to white), and the bilinear taps at
-            // its edge mix a share of it with the background's CoC (up to 8 % in focus).
+            // its edge mix a share of it with the background's CoC (up to 4.3 % in focus).
             EXPECT_LT(stray, 0.1) << c.name << ", " << preset.name;
+            // In focus, below 6 %: a tap above white that its own blur does not bring here is
+            // hidden, not lit. Counted as white's worth instead, it left 7.4-7.6 % of the light
+            // outside its reach (3.3 % at full size).
+            if (c.depthM == 0.99f)
+                EXPECT_LT(stray, 0.06) << c.name << ", " << preset.name;
         }
     }
 }
