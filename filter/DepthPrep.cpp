@@ -106,30 +106,38 @@ std::size_t putLightEdgesAtTheirLightsDepth(const cv::Mat& colorLinear, cv::Mat&
     CV_Assert(colorLinear.type() == CV_32FC3 && metres.type() == CV_32FC1 && colorLinear.size() == metres.size());
     const auto luminance = [](const cv::Vec3f& bgr) { return 0.0722f * bgr[0] + 0.7152f * bgr[1] + 0.2126f * bgr[2]; };
     // Decided on the depth as it was: a changed pixel must not move its neighbours, so the
-    // changes (a light's edge pixels: few) are applied after the scan.
-    std::vector<std::pair<cv::Point, float>> changes;
+    // changes (a light's edge pixels: few) are applied after the scan, which runs in bands of
+    // rows on OpenCV's threads, each band with its own list.
     const int last = colorLinear.rows - 1, lastX = colorLinear.cols - 1;
-    for (int y = 0; y <= last; ++y) {
-        const auto* row = colorLinear.ptr<cv::Vec3f>(y);
-        for (int x = 0; x <= lastX; ++x) {
-            const float brightness = luminance(row[x]);
-            if (!(brightness > 1.0f))
-                continue;
-            float brightest = brightness;
-            cv::Point at{x, y};
-            for (int qy = std::max(y - 1, 0); qy <= std::min(y + 1, last); ++qy)
-                for (int qx = std::max(x - 1, 0); qx <= std::min(x + 1, lastX); ++qx)
-                    if (const float b = luminance(colorLinear.at<cv::Vec3f>(qy, qx)); b > brightest) {
-                        brightest = b;
-                        at = {qx, qy};
-                    }
-            if (const float z = metres.at<float>(at); z < metres.at<float>(y, x))
-                changes.emplace_back(cv::Point{x, y}, z);
+    std::vector<std::vector<std::pair<cv::Point, float>>> bands(static_cast<std::size_t>(colorLinear.rows));
+    cv::parallel_for_(cv::Range(0, colorLinear.rows), [&](const cv::Range& range) {
+        for (int y = range.start; y < range.end; ++y) {
+            auto& changes = bands[static_cast<std::size_t>(y)];
+            const auto* row = colorLinear.ptr<cv::Vec3f>(y);
+            for (int x = 0; x <= lastX; ++x) {
+                const float brightness = luminance(row[x]);
+                if (!(brightness > 1.0f))
+                    continue;
+                float brightest = brightness;
+                cv::Point at{x, y};
+                for (int qy = std::max(y - 1, 0); qy <= std::min(y + 1, last); ++qy)
+                    for (int qx = std::max(x - 1, 0); qx <= std::min(x + 1, lastX); ++qx)
+                        if (const float b = luminance(colorLinear.at<cv::Vec3f>(qy, qx)); b > brightest) {
+                            brightest = b;
+                            at = {qx, qy};
+                        }
+                if (const float z = metres.at<float>(at); z < metres.at<float>(y, x))
+                    changes.emplace_back(cv::Point{x, y}, z);
+            }
         }
-    }
-    for (const auto& [at, z] : changes)
-        metres.at<float>(at) = z;
-    return changes.size();
+    });
+    std::size_t count = 0;
+    for (const auto& changes : bands)
+        for (const auto& [at, z] : changes) {
+            metres.at<float>(at) = z;
+            ++count;
+        }
+    return count;
 }
 
 float centreDepth(const cv::Mat& depth, double windowFraction, float fallbackM)

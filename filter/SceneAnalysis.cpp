@@ -66,19 +66,32 @@ SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, 
     m.pixels = filledDepth.total();
 
     // Rows of tiles are independent: OpenCV's threads take them in bands, each band with its
-    // own histogram.
+    // own counts, the depth and the colour of a band in one visit. Each row's |CoC| goes to a
+    // buffer first and the histogram's edges are counted over it, loops the compiler vectorises
+    // (the bin index per pixel, one increment at a time, took 1.2 ms at 640x480 for both loops).
+    // Highlights: 8-bit, any channel clipped (>= 250); float, luminance above 1. With the
+    // luminance summed (linear: 8-bit decoded from sRGB), per tile.
+    constexpr std::size_t kEdges = SceneAnalysis::kHistogramEdges.size();
+    std::array<float, 256> decode{};
+    for (std::size_t i = 0; i < decode.size(); ++i)
+        decode[i] = srgbToLinear(static_cast<float>(i) / 255.0f);
     m.tileMinDepth.create(m.tiles, CV_32F);
     m.tileMaxDepth.create(m.tiles, CV_32F);
-    constexpr std::size_t kBins = SceneAnalysis::kHistogramEdges.size() + 1;
-    std::vector<std::array<int, kBins>> bandHistograms(static_cast<std::size_t>(m.tiles.height));
+    m.tileHighlights = cv::Mat::zeros(m.tiles, CV_32S);
+    m.tileLuminance = cv::Mat::zeros(m.tiles, CV_32F);
+    // Per band: the pixels whose |CoC| reaches each edge.
+    std::vector<std::array<std::size_t, kEdges>> bandReach(static_cast<std::size_t>(m.tiles.height));
     cv::parallel_for_(cv::Range(0, m.tiles.height), [&](const cv::Range& range) {
+        std::vector<float> coc(static_cast<std::size_t>(filledDepth.cols));
         for (int ty = range.start; ty < range.end; ++ty) {
             float* lo = m.tileMinDepth.ptr<float>(ty);
             float* hi = m.tileMaxDepth.ptr<float>(ty);
             std::fill(lo, lo + m.tiles.width, std::numeric_limits<float>::max());
             std::fill(hi, hi + m.tiles.width, std::numeric_limits<float>::lowest());
-            std::array<int, kBins>& histogram = bandHistograms[static_cast<std::size_t>(ty)];
-            histogram.fill(0);
+            std::array<std::size_t, kEdges>& reach = bandReach[static_cast<std::size_t>(ty)];
+            reach.fill(0);
+            int* counts = m.tileHighlights.ptr<int>(ty);
+            float* sums = m.tileLuminance.ptr<float>(ty);
             for (int y = ty * T; y < std::min((ty + 1) * T, filledDepth.rows); ++y) {
                 const float* z = filledDepth.ptr<float>(y);
                 for (int tx = 0; tx < m.tiles.width; ++tx) {
@@ -86,52 +99,56 @@ SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, 
                     for (int x = tx * T; x < std::min((tx + 1) * T, filledDepth.cols); ++x) {
                         tileLo = std::min(tileLo, z[x]);
                         tileHi = std::max(tileHi, z[x]);
-                        // The bin: how many edges |CoC| reaches (std::upper_bound's index).
-                        const float c = std::abs(cocPixels(k, z[x]));
-                        std::size_t bin = 0;
-                        for (const float edge : SceneAnalysis::kHistogramEdges)
-                            bin += c >= edge ? 1 : 0;
-                        ++histogram[bin];
                     }
                     lo[tx] = tileLo;
                     hi[tx] = tileHi;
                 }
-            }
-        }
-    });
-    for (const auto& band : bandHistograms)
-        for (std::size_t bin = 0; bin < kBins; ++bin)
-            m.histogram[bin] += band[bin];
-
-    // Highlights: 8-bit, any channel clipped (>= 250); float, luminance above 1. With the
-    // luminance summed (linear: 8-bit decoded from sRGB), per tile, in bands of tile rows too.
-    std::array<float, 256> decode{};
-    for (std::size_t i = 0; i < decode.size(); ++i)
-        decode[i] = srgbToLinear(static_cast<float>(i) / 255.0f);
-    m.tileHighlights = cv::Mat::zeros(m.tiles, CV_32S);
-    m.tileLuminance = cv::Mat::zeros(m.tiles, CV_32F);
-    cv::parallel_for_(cv::Range(0, m.tiles.height), [&](const cv::Range& range) {
-        for (int ty = range.start; ty < range.end; ++ty) {
-            int* counts = m.tileHighlights.ptr<int>(ty);
-            float* sums = m.tileLuminance.ptr<float>(ty);
-            for (int y = ty * T; y < std::min((ty + 1) * T, color.rows); ++y) {
-                if (color.depth() == CV_8U) {
-                    const std::uint8_t* p = color.ptr<std::uint8_t>(y);
-                    for (int x = 0; x < color.cols; ++x, p += 3) {
-                        counts[x / T] += std::max(p[0], std::max(p[1], p[2])) >= 250 ? 1 : 0;
-                        sums[x / T] += luminanceBgr(decode[p[0]], decode[p[1]], decode[p[2]]);
+                for (int x = 0; x < filledDepth.cols; ++x)
+                    coc[static_cast<std::size_t>(x)] = std::abs(cocPixels(k, z[x]));
+                for (std::size_t i = 0; i < kEdges; ++i) {
+                    const float edge = SceneAnalysis::kHistogramEdges[i];
+                    int reached = 0;
+                    for (const float c : coc)
+                        reached += c >= edge ? 1 : 0;
+                    reach[i] += static_cast<std::size_t>(reached);
+                }
+                // A tile's count and sum in registers across its pixels of the row (in memory,
+                // each pixel waited for the previous one's store).
+                for (int tx = 0; tx < m.tiles.width; ++tx) {
+                    const int x0 = tx * T, x1 = std::min(x0 + T, color.cols);
+                    int count = counts[tx];
+                    float sum = sums[tx];
+                    if (color.depth() == CV_8U) {
+                        const std::uint8_t* p = color.ptr<std::uint8_t>(y) + 3 * x0;
+                        for (int x = x0; x < x1; ++x, p += 3) {
+                            count += std::max(p[0], std::max(p[1], p[2])) >= 250 ? 1 : 0;
+                            sum += luminanceBgr(decode[p[0]], decode[p[1]], decode[p[2]]);
+                        }
+                    } else {
+                        const float* p = color.ptr<float>(y) + 3 * x0;
+                        for (int x = x0; x < x1; ++x, p += 3) {
+                            const float brightness = luminanceBgr(p[0], p[1], p[2]);
+                            count += brightness > 1.0f ? 1 : 0;
+                            sum += brightness;
+                        }
                     }
-                } else {
-                    const float* p = color.ptr<float>(y);
-                    for (int x = 0; x < color.cols; ++x, p += 3) {
-                        const float brightness = luminanceBgr(p[0], p[1], p[2]);
-                        counts[x / T] += brightness > 1.0f ? 1 : 0;
-                        sums[x / T] += brightness;
-                    }
+                    counts[tx] = count;
+                    sums[tx] = sum;
                 }
             }
         }
     });
+    // Bin b holds the pixels that reach edge b - 1 but not edge b.
+    std::array<std::size_t, kEdges> reach{};
+    for (const auto& band : bandReach)
+        for (std::size_t i = 0; i < kEdges; ++i)
+            reach[i] += band[i];
+    std::size_t previous = m.pixels;
+    for (std::size_t i = 0; i < kEdges; ++i) {
+        m.histogram[i] = static_cast<int>(previous - reach[i]);
+        previous = reach[i];
+    }
+    m.histogram[kEdges] = static_cast<int>(previous);
     m.highlightPixels = static_cast<std::size_t>(cv::sum(m.tileHighlights)[0]);
     return m;
 }

@@ -1,10 +1,14 @@
 // The scene analysis (filter/SceneAnalysis): the tiles with highlights and the neighbourhoods the
 // bokeh sprites judge lights in, and the plan's tap loops.
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
+#include "filter/ColorSpace.hpp"
 #include "filter/Lens.hpp"
 #include "filter/SceneAnalysis.hpp"
 
@@ -62,6 +66,67 @@ TEST(SceneAnalysisHighlights, NeighbourhoodsSumTheTilesAroundInTheFrame)
     EXPECT_EQ(middle[0], 48.0f * 41.0f);
     EXPECT_EQ(middle[1], 1.0f);
     EXPECT_NEAR(middle[2], (48.0f * 41.0f - 2.0f) * grey + luminance(0.0f, 3.0f, 0.0f) + 0.99f, 1e-2);
+}
+
+TEST(SceneAnalysisMeasure, MatchesAPixelByPixelCount)
+{
+    // Catches a pixel in the wrong |CoC| bin, a tile's range, count or luminance from the wrong
+    // pixels (measureScene() counts edges over row buffers and keeps a tile's sums in registers):
+    // against the plain definition, pixel by pixel. 75 x 41 (partial tiles), random depths
+    // 0.3-20 m, random colour with clipped and HDR pixels, 8-bit and float.
+    cv::RNG rng(11);
+    cv::Mat depth(41, 75, CV_32F);
+    rng.fill(depth, cv::RNG::UNIFORM, 0.3, 20.0);
+    LensSettings lens;
+    lens.focusM = 2.0;
+    lens.fNumber = 1.0;
+    lens.maxCocPx = 40.0;
+    const CocCoefficients k = cocCoefficients(lens, depth.cols);
+    cv::Mat eightBit(depth.size(), CV_8UC3), linear(depth.size(), CV_32FC3);
+    rng.fill(eightBit, cv::RNG::UNIFORM, 0, 256);
+    rng.fill(linear, cv::RNG::UNIFORM, 0.0, 3.0);
+    const auto luminance = [](float b, float g, float r) { return 0.0722f * b + 0.7152f * g + 0.2126f * r; };
+    for (const cv::Mat& color : {eightBit, linear}) {
+        const SceneMeasurement m = measureScene(depth, color, k);
+        std::array<int, SceneAnalysis::kHistogramEdges.size() + 1> histogram{};
+        cv::Mat lo(m.tiles, CV_32F, cv::Scalar(1e9)), hi(m.tiles, CV_32F, cv::Scalar(-1e9));
+        cv::Mat highlights = cv::Mat::zeros(m.tiles, CV_32S);
+        cv::Mat sums = cv::Mat::zeros(m.tiles, CV_64F);
+        for (int y = 0; y < depth.rows; ++y)
+            for (int x = 0; x < depth.cols; ++x) {
+                const float z = depth.at<float>(y, x);
+                const float c = std::abs(cocPixels(k, z));
+                const auto& edges = SceneAnalysis::kHistogramEdges;
+                ++histogram[static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), c) - edges.begin())];
+                const cv::Point tile(x / 16, y / 16);
+                lo.at<float>(tile) = std::min(lo.at<float>(tile), z);
+                hi.at<float>(tile) = std::max(hi.at<float>(tile), z);
+                float brightness = 0.0f;
+                bool highlight = false;
+                if (color.type() == CV_8UC3) {
+                    const cv::Vec3b p = color.at<cv::Vec3b>(y, x);
+                    brightness = luminance(srgbToLinear(p[0] / 255.0f), srgbToLinear(p[1] / 255.0f),
+                                           srgbToLinear(p[2] / 255.0f));
+                    highlight = std::max({p[0], p[1], p[2]}) >= 250;
+                } else {
+                    const cv::Vec3f p = color.at<cv::Vec3f>(y, x);
+                    brightness = luminance(p[0], p[1], p[2]);
+                    highlight = brightness > 1.0f;
+                }
+                highlights.at<int>(tile) += highlight ? 1 : 0;
+                sums.at<double>(tile) += brightness;
+            }
+        EXPECT_EQ(m.histogram, histogram);
+        EXPECT_EQ(cv::norm(m.tileMinDepth, lo, cv::NORM_INF), 0.0);
+        EXPECT_EQ(cv::norm(m.tileMaxDepth, hi, cv::NORM_INF), 0.0);
+        EXPECT_EQ(cv::norm(m.tileHighlights, highlights, cv::NORM_INF), 0.0);
+        cv::Mat measured;
+        m.tileLuminance.convertTo(measured, CV_64F);
+        // Float sums of up to 256 pixels of up to 3 (about 400) against double ones: a float
+        // rounding there is 3e-5, a tile's sum a few hundred of them at most.
+        EXPECT_LT(cv::norm(measured, sums, cv::NORM_INF), 1e-2);
+        EXPECT_EQ(m.highlightPixels, static_cast<std::size_t>(cv::sum(highlights)[0]));
+    }
 }
 
 TEST(ScenePlan, TapLoopsUnrollWhereMostLinesRunToTheLastTap)
