@@ -479,13 +479,12 @@ void Pipeline::Impl::render()
         if (neighbourhoods.size() != bytes)
             neighbourhoods = gl::StorageBuffer(bytes, "tile neighbourhoods");
         neighbourhoods.update(analysis.tileNeighbourhood.data, bytes);
-    }
-    if (plan.highlightSprites)
         highlightSpritePass.find(colorTexture, depth, coefficients, static_cast<float>(plan.highlightGain),
                                  CocPass::largestColor(half), bladeRotationDeg, plan.nearField,
                                  neighbourhoods, analysis.highlightTiles,
                                  HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
                                                              analysis.highlightPixels));
+    }
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
     if (plan.highlightSprites || plan.highlightGain > 1.0)
         highlightTiles.set(analysis.highlightTiles, blurSize, tileSize());
