@@ -68,7 +68,8 @@ SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, 
     // Rows of tiles are independent: OpenCV's threads take them in bands, each band with its
     // own counts, the depth and the colour of a band in one visit. Each row's |CoC| goes to a
     // buffer first and the histogram's edges are counted over it, loops the compiler vectorises
-    // (the bin index per pixel, one increment at a time, took 1.2 ms at 640x480 for both loops).
+    // (with a bin index per pixel, one increment at a time, and a tile's sums kept in memory, the
+    // TUM clip's analysis at 1920x1080 took 8.5 instead of 6.0 ms: docs/benchmarks.md).
     // Highlights: 8-bit, any channel clipped (>= 250); float, luminance above 1. With the
     // luminance summed (linear: 8-bit decoded from sRGB), per tile.
     constexpr std::size_t kEdges = SceneAnalysis::kHistogramEdges.size();

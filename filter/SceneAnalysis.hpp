@@ -77,9 +77,10 @@ struct SceneMeasurement {
 };
 
 /// Measures a frame from its filled depth (CV_32FC1 metres) and colour (CV_8UC3 sRGB or CV_32FC3
-/// linear, BGR), in bands of tile rows on OpenCV's threads. On llvmpipe, with a compute pass per
-/// tile instead, the TUM clip took 12.3 instead of 8.0 ms a frame at 1920x1080 (and 2.1-2.6
-/// against 1.4 at 640x480) before the upload and plan, since the plan waits for it either way.
+/// linear, BGR), in bands of tile rows on OpenCV's threads. A compute pass per tile on llvmpipe,
+/// which the plan waited for, took longer: 12.6 against 8.7 ms for the analysis and plan of the
+/// TUM clip at 1920x1080, and 6.0 ms since the loops were made to vectorise (docs/benchmarks.md,
+/// "Sprites on their tiles, the analysis on the CPU").
 SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k);
 
 /// The analysis from a measurement: tile CoC ranges (CoC is monotonic in depth, so a tile's
