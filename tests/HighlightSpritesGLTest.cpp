@@ -230,8 +230,9 @@ TEST_F(HighlightSprites, ALightInFrontOfABlurredBackgroundIsNotDrawnASecondTimeB
             // In focus, below 6 %: a tap above white that its own blur does not bring here is
             // hidden, not lit. Counted as white's worth instead, it left 7.4-7.6 % of the light
             // outside its reach (3.3 % at full size).
-            if (c.depthM == 0.99f)
+            if (c.depthM == 0.99f) {
                 EXPECT_LT(stray, 0.06) << c.name << ", " << preset.name;
+            }
         }
     }
 }
