@@ -46,6 +46,24 @@ protected:
         depth.colRange(0, focusColumns).setTo(1.0f);
         return {color, depth, 0.0, 0, "textured"};
     }
+
+    /// `out` (8-bit, the frame's size) keeps the frame's pixels in columns [0, keptColumns), to
+    /// the bit in every channel, and has blurred `blurredColumns`: their standard deviation
+    /// (the noise) below a third of the input's.
+    static void expectKeptAndBlurred(const Frame& frame, const cv::Mat& out, int keptColumns,
+                                     cv::Range blurredColumns)
+    {
+        cv::Mat sharp = cv::Mat::zeros(frame.color.size(), CV_8U);
+        sharp.colRange(0, keptColumns).setTo(255);
+        cv::Mat diff, anyChannel;
+        cv::absdiff(out, frame.color, diff);
+        cv::transform(diff, anyChannel, cv::Matx13f(1, 1, 1));
+        EXPECT_EQ(cv::countNonZero(anyChannel & sharp), 0);
+        cv::Scalar mean, stddevIn, stddevOut;
+        cv::meanStdDev(frame.color.colRange(blurredColumns), mean, stddevIn);
+        cv::meanStdDev(out.colRange(blurredColumns), mean, stddevOut);
+        EXPECT_LT(stddevOut[0], stddevIn[0] / 3.0);
+    }
 };
 
 TEST_F(HalfSize, OutputHasTheFrameSizeAndEveryViewToo)
@@ -122,18 +140,8 @@ TEST_F(HalfSize, InFocusPixelsComeOutAsTheyWentIn)
     const cv::Mat out = pipeline.run(frame, test::lensWithFarCoc(12.0), quality(Resolution::Half));
     // The upscale interpolates what the blur added, so an in-focus pixel within a pixel of a
     // blurred one may take a share of it; from two pixels away nothing may change, to the bit.
-    cv::Mat sharp = cv::Mat::zeros(frame.color.size(), CV_8U);
-    sharp.colRange(0, 48 - 2).setTo(255);
-    cv::Mat diff;
-    cv::absdiff(out, frame.color, diff);
-    cv::Mat anyChannel;
-    cv::transform(diff, anyChannel, cv::Matx13f(1, 1, 1));
-    EXPECT_EQ(cv::countNonZero(anyChannel & sharp), 0);
-    // and the far part is blurred: most of its noise is gone.
-    cv::Scalar mean, stddevIn, stddevOut;
-    cv::meanStdDev(frame.color.colRange(60, 96), mean, stddevIn);
-    cv::meanStdDev(out.colRange(60, 96), mean, stddevOut);
-    EXPECT_LT(stddevOut[0], stddevIn[0] / 3.0);
+    // And the far part is blurred: most of its noise is gone.
+    expectKeptAndBlurred(frame, out, 48 - 2, cv::Range(60, 96));
 }
 
 TEST_F(HalfSize, BlurMatchesTheFullSizeBlur)
@@ -241,16 +249,7 @@ TEST_F(HalfSize, LargeBlurRunsAtQuarterSizeAndKeepsTheInFocusPixels)
     EXPECT_EQ(pipeline.readTarget(View::Input).size(), cv::Size(25, 17));
     ASSERT_EQ(out.size(), frame.color.size());
     // From four pixels (one quarter-size texel) away from the blurred part nothing may change.
-    cv::Mat sharp = cv::Mat::zeros(frame.color.size(), CV_8U);
-    sharp.colRange(0, 48 - 4).setTo(255);
-    cv::Mat diff, anyChannel;
-    cv::absdiff(out, frame.color, diff);
-    cv::transform(diff, anyChannel, cv::Matx13f(1, 1, 1));
-    EXPECT_EQ(cv::countNonZero(anyChannel & sharp), 0);
-    cv::Scalar mean, stddevIn, stddevOut;
-    cv::meanStdDev(frame.color.colRange(64, 98), mean, stddevIn);
-    cv::meanStdDev(out.colRange(64, 98), mean, stddevOut);
-    EXPECT_LT(stddevOut[0], stddevIn[0] / 3.0);
+    expectKeptAndBlurred(frame, out, 48 - 4, cv::Range(64, 98));
 }
 
 TEST_F(HalfSize, QuarterSizeBlurMatchesTheHalfSizeBlur)
