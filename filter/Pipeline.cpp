@@ -299,29 +299,26 @@ void Pipeline::Impl::prepareDepthAndPlan()
 
     analysis = analyseScene(prepared.metres, color, coefficients, prepared.invalidFraction);
     const bool allInFocus = plan.allInFocus && quality.adaptive;
-    plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples,
-                    quality.quarterOnLargeBlur);
-    setBlurShift(plan.blurShift);
-    if (color.type() == CV_8UC3 && plan.highlights && !plan.allInFocus)
-        plan.highlightGain = quality.highlightGain;
+    // Highlights to treat: the plan's (FramePlan::highlights) on a frame not all in focus, which
+    // makePlan() derives from the analysis alone, whatever size it picks.
+    const bool lights = analysis.hasHighlights() && !analysis.allInFocus();
+    const bool eightBit = color.type() == CV_8UC3;
+    const double highlightGain = eightBit && lights ? quality.highlightGain : 1.0;
     // Sprites where a blurred pixel can be brighter than white: float input's highlights, or
     // 8-bit ones scaled up by the gain; and only where such pixels are few, lights rather than
     // bright surfaces (HighlightSpritePass::kMostHighlightPixels).
-    plan.highlightSprites = quality.highlightSprites && quality.kernel == HexagonKernel::RhombiSum &&
-                            plan.highlights && !plan.allInFocus &&
-                            (color.type() != CV_8UC3 || plan.highlightGain > 1.0) &&
-                            analysis.highlightFraction <= HighlightSpritePass::kMostHighlightPixels;
+    const bool sprites = quality.highlightSprites && quality.kernel == HexagonKernel::RhombiSum && lights &&
+                         (!eightBit || highlightGain > 1.0) &&
+                         analysis.highlightFraction <= HighlightSpritePass::kMostHighlightPixels;
     // Quarter size only on frames without bokeh sprites: the rims of the lights' hexagons, which
     // the gather draws up to white, came out 4 px soft at quarter size (the corpus enlarged 3x,
     // `defocus-bench accuracy --scale 3`: 0.38 dB less in the median, most of it in the lights'
     // zone; docs/benchmarks.md).
-    if (plan.highlightSprites && plan.blurShift == 2) {
-        const FramePlan quarter = plan;
-        plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples, false);
-        plan.highlightGain = quarter.highlightGain;
-        plan.highlightSprites = quarter.highlightSprites;
-        setBlurShift(plan.blurShift);
-    }
+    plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples,
+                    quality.quarterOnLargeBlur && !sprites);
+    setBlurShift(plan.blurShift);
+    plan.highlightGain = highlightGain;
+    plan.highlightSprites = sprites;
     plan.allInFocus = plan.allInFocus || allInFocus;
 }
 

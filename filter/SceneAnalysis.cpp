@@ -227,9 +227,9 @@ FramePlan makePlan(const SceneAnalysis& analysis, bool nearField, HexagonKernel 
 {
     FramePlan plan;
     plan.blurShift = resolution == Resolution::Full ? 0 : quarterOnLargeBlur ? halfOrQuarterShift(analysis) : 1;
-    plan.allInFocus = analysis.maxAbsCoc() < 0.5f;
+    plan.allInFocus = analysis.allInFocus();
     plan.holeFill = analysis.invalidDepthFraction > 0.0;
-    plan.highlights = analysis.highlightFraction > 0.0;
+    plan.highlights = analysis.hasHighlights();
     plan.foreground = analysis.foreground;
     if (plan.allInFocus)
         return plan;

@@ -58,6 +58,10 @@ struct SceneAnalysis {
 
     /// Largest |CoC| of the frame.
     float maxAbsCoc() const;
+    /// Every |CoC| under half a pixel: nothing to blur (FramePlan::allInFocus).
+    bool allInFocus() const { return maxAbsCoc() < 0.5f; }
+    /// Some pixel above the highlight threshold (FramePlan::highlights).
+    bool hasHighlights() const { return highlightFraction > 0.0; }
     /// |CoC| of the tile at (x, y) reaches `sharpBelowPx` somewhere (the blur's in-focus limit).
     bool tileNeedsBlur(int x, int y, float sharpBelowPx = 0.5f) const;
 };
