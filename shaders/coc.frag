@@ -14,7 +14,8 @@
 // The last row and column repeat on frames of odd size. QUARTER_SIZE: the same over 4x4 pixels
 // (a quarter of the frame's size, CoC in quarter-size pixels), for frames whose blur is large
 // and that have no sprites. HIGHLIGHTS (with highlightGain > 1, or bokeh sprites): the variant
-// that treats highlights pixel by pixel before the mean. SPRITES (bokeh sprites,
+// that treats highlights pixel by pixel before the mean, drawn only on the tiles that have
+// highlights, over the plain variant's texels (CocPass). SPRITES (bokeh sprites,
 // highlightThreshold > 0): a pixel's light above the threshold leaves the gather for its sprite;
 // compiled out of the other variants, where llvmpipe would run it for every pixel.
 #include "common.glsl"

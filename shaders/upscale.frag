@@ -1,7 +1,8 @@
 #version 450 core
-// Upscale (Resolution::Half): the frame-sized result from the half-size (or quarter-size: BLUR_SCALE
-// 0.25, DETAIL_BELOW_PX 4) blur R of C (the CoC pass's target), by way of upscale_prefilter.frag's S (R sharpened) and D = R - C. With bil()
-// the bilinear interpolation at the pixel's centre:
+// Upscale (Resolution::Half): the frame-sized result from the half-size (or quarter-size:
+// BLUR_SCALE 0.25, DETAIL_BELOW_PX 4) blur R of C (the CoC pass's target), by way of
+// upscale_prefilter.frag's S (R sharpened) and D = R - C. With bil() the bilinear interpolation
+// at the pixel's centre:
 //
 //   interpolated = bil(S)                      the blur, as sharp as the half size holds it
 //   kept         = frame + bil(D)              the frame's own pixel plus what the blur added
