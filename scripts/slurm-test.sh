@@ -141,8 +141,13 @@ left=$(frames_on_disk out/clip3)
 [ "$left" -eq 0 ] || fail "the cancelled clip 3 left $left frames that look like output"
 [ -e out/clip1.report.json ] || fail "clip 1, finished before the cancel, has no report"
 
+# slurmd revoked job 1's credential when it killed the task, and a launch whose credential is dated
+# the same second counts as revoked ("Job credential revoked": the task fails with exit 1). So the
+# restart waits out that second. StartTime=now: a requeued job waits ~2 min otherwise, and a start
+# time in the future waits for the scheduler's next periodic pass (a minute).
+sleep 1.1
 scontrol requeue "${job}_1" || fail "scontrol requeue ${job}_1 failed"
-scontrol update jobid="${job}_1" StartTime=now >/dev/null # a requeued job waits ~2 min otherwise
+scontrol update jobid="${job}_1" StartTime=now >/dev/null
 echo "slurm-test: requeued task 1"
 for _ in $(seq 1800); do
   [ -z "$(squeue -h -j "$job" 2>/dev/null)" ] && break
