@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -27,6 +28,26 @@ struct PreparedDepth {
 /// averages of the valid neighbours, coarse levels filling what finer ones cannot. A frame with
 /// no valid depth at all (or no depth) becomes `fallbackM` everywhere.
 PreparedDepth prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM);
+
+/// The buffers prepareDepth() works in: the frame-sized weights and hole mask and a push-pull
+/// pyramid, kept from frame to frame. Taken anew, buffers of megabytes come from the system a
+/// page fault per 4 KB of first touch, and whether glibc keeps freed ones for the next frame
+/// depends on what else the process allocates: a 1920x1080 TUM frame's depth took 6 ms one way
+/// and 90 ms the other (docs/benchmarks.md, "Buffers kept from frame to frame").
+struct DepthPrepWorkspace {
+    struct Level {
+        cv::Mat weighted, weight, value, scratch, up;
+        cv::Mat mask;
+    };
+    cv::Mat weight, holes, up;
+    std::vector<Level> levels; ///< [0] unused; [1] half the frame's size, [2] a quarter, ...
+};
+
+/// prepareDepth() into `out`, with the buffers of `workspace` (grown as needed). out.metres is
+/// written in place when it already has the size and type and nothing else refers to its buffer;
+/// otherwise it is allocated anew.
+void prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM, DepthPrepWorkspace& workspace,
+                  PreparedDepth& out);
 
 /// A pixel of `colorLinear` (CV_32FC3, linear BGR) above white (Rec. 709 luminance > 1) takes,
 /// in `metres` (CV_32FC1, the same size, filled), the depth of the brightest pixel of its 3x3

@@ -131,6 +131,7 @@ struct Pipeline::Impl {
     cv::Size blurSize; ///< the blur passes': the frame's, or half or a quarter of it (Resolution::Half)
     int blurShift = 0; ///< log2 of size / blurSize (the plan's FramePlan::blurShift)
     PreparedDepth prepared;
+    DepthPrepWorkspace depthWorkspace; // prepareDepth()'s buffers, kept from frame to frame
     float maxCocPx = 0.0f;
     FrameTimings timings;
     Clock::time_point frameStart;
@@ -280,7 +281,7 @@ void Pipeline::Impl::prepareDepthAndPlan()
 {
     // Depth: colour-sized, holes filled. With no depth at all, everything sits on the focus plane.
     auto start = Clock::now();
-    prepared = prepareDepth(depthInput, size, fallbackDepth);
+    prepareDepth(depthInput, size, fallbackDepth, depthWorkspace, prepared);
     // The rhombi's bokeh sprites take the light above white out of the gather; its edges go with
     // it (float frames only: 8-bit ones have nothing above white).
     if (color.type() == CV_32FC3 && quality.kernel == HexagonKernel::RhombiSum && quality.highlightSprites)

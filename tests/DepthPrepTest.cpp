@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -67,6 +68,72 @@ TEST(DepthPrep, NoValidDepthGivesTheFallback)
     const auto none = prepareDepth(cv::Mat(), {8, 6}, 3.5f);
     EXPECT_EQ(none.metres.size(), cv::Size(8, 6));
     EXPECT_EQ(cv::countNonZero(none.metres != 3.5f), 0);
+}
+
+// A depth frame of `size` with a ramp of depths and holes where `seed` puts them (a share of
+// about `holes`), and now and then a block of holes that only coarse levels fill.
+cv::Mat depthWithHoles(cv::Size size, unsigned seed, double holes)
+{
+    cv::Mat depth(size, CV_32F);
+    cv::RNG rng(seed);
+    for (int y = 0; y < size.height; ++y)
+        for (int x = 0; x < size.width; ++x)
+            depth.at<float>(y, x) = rng.uniform(0.0, 1.0) < holes ? 0.0f : 0.5f + 0.01f * static_cast<float>(x + y);
+    if (holes > 0.0)
+        depth(cv::Rect(size.width / 4, size.height / 3, size.width / 3, size.height / 4)).setTo(0.0f);
+    return depth;
+}
+
+// Buffers kept from frame to frame must not carry one frame into the next: each frame through
+// one workspace, whatever the frame before it (another size, other holes, none, all), must equal
+// the same frame through fresh buffers, to the bit.
+TEST(DepthPrepWorkspace, EachFrameEqualsItsOwnFreshResult)
+{
+    struct Step {
+        cv::Mat depth;
+        cv::Size size;
+    };
+    const std::vector<Step> steps{
+        {depthWithHoles({64, 48}, 1, 0.3), {64, 48}},
+        {depthWithHoles({64, 48}, 2, 0.05), {64, 48}},
+        {depthWithHoles({37, 29}, 3, 0.3), {37, 29}},   // smaller, odd: fewer and odd levels
+        {depthWithHoles({32, 24}, 4, 0.2), {64, 48}},   // resized to the frame
+        {depthWithHoles({64, 48}, 5, 0.0), {64, 48}},   // no holes: no pyramid
+        {cv::Mat(48, 64, CV_32F, cv::Scalar(0.0f)), {64, 48}}, // no valid depth
+        {cv::Mat(), {64, 48}},                                  // no depth
+        {depthWithHoles({64, 48}, 1, 0.3), {64, 48}},
+    };
+    DepthPrepWorkspace workspace;
+    PreparedDepth kept;
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        const PreparedDepth fresh = prepareDepth(steps[i].depth, steps[i].size, 2.5f);
+        prepareDepth(steps[i].depth, steps[i].size, 2.5f, workspace, kept);
+        ASSERT_EQ(kept.metres.size(), fresh.metres.size()) << "step " << i;
+        EXPECT_EQ(kept.invalidFraction, fresh.invalidFraction) << "step " << i;
+        EXPECT_EQ(cv::norm(kept.metres, fresh.metres, cv::NORM_INF), 0.0) << "step " << i;
+    }
+}
+
+// The output is written in place from frame to frame, not into a buffer taken while the last
+// one is still alive (as assigning a fresh result would), except where the caller still holds
+// the last one: that one keeps its depths.
+TEST(DepthPrepWorkspace, OutputIsReusedUnlessTheCallerHoldsIt)
+{
+    DepthPrepWorkspace workspace;
+    PreparedDepth out;
+    prepareDepth(depthWithHoles({64, 48}, 1, 0.3), {64, 48}, 2.5f, workspace, out);
+    const uchar* first = out.metres.data;
+    const uchar* firstLevel = workspace.levels.at(1).value.data;
+    prepareDepth(depthWithHoles({64, 48}, 2, 0.3), {64, 48}, 2.5f, workspace, out);
+    EXPECT_EQ(out.metres.data, first);
+    EXPECT_EQ(workspace.levels.at(1).value.data, firstLevel);
+
+    const cv::Mat held = out.metres;
+    const cv::Mat heldCopy = held.clone();
+    prepareDepth(depthWithHoles({64, 48}, 3, 0.3), {64, 48}, 2.5f, workspace, out);
+    EXPECT_NE(out.metres.data, held.data);
+    EXPECT_EQ(cv::norm(held, heldCopy, cv::NORM_INF), 0.0);
+    EXPECT_GT(cv::norm(out.metres, heldCopy, cv::NORM_INF), 0.0);
 }
 
 TEST(DepthPrep, CentreDepthIsTheMedianOfValidCentrePixels)
