@@ -32,8 +32,9 @@ PreparedDepth prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM)
 /// The buffers prepareDepth() works in: the frame-sized weights and hole mask and a push-pull
 /// pyramid, kept from frame to frame. Taken anew, buffers of megabytes come from the system a
 /// page fault per 4 KB of first touch, and whether glibc keeps freed ones for the next frame
-/// depends on what else the process allocates: a 1920x1080 TUM frame's depth took 6 ms one way
-/// and 90 ms the other (docs/benchmarks.md, "Buffers kept from frame to frame").
+/// depends on what else the process allocates: the TUM clip's depth at 1920x1080 took 9 ms per
+/// frame with the buffers kept and 84-89 ms without (docs/benchmarks.md, "Buffers kept from
+/// frame to frame").
 struct DepthPrepWorkspace {
     struct Level {
         cv::Mat weighted, weight, value, scratch, up;
