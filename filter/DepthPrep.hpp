@@ -32,9 +32,9 @@ PreparedDepth prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM)
 /// The buffers prepareDepth() works in: the frame-sized weights and hole mask and a push-pull
 /// pyramid, kept from frame to frame. Taken anew, buffers of megabytes come from the system a
 /// page fault per 4 KB of first touch, and whether glibc keeps freed ones for the next frame
-/// depends on what else the process allocates: the TUM clip's depth at 1920x1080 took 9 ms per
-/// frame with the buffers kept and 84-89 ms without (docs/benchmarks.md, "Buffers kept from
-/// frame to frame").
+/// depends on what else the process allocates. The GStreamer element did not keep them: the
+/// TUM clip at 1920x1080 took up to 100 ms a frame more without this workspace
+/// (docs/benchmarks.md, "Buffers kept from frame to frame").
 struct DepthPrepWorkspace {
     struct Level {
         cv::Mat weighted, weight, value, scratch, up;
