@@ -33,11 +33,13 @@
 #include "samples/FocusSchedule.hpp"
 #include "samples/NewestFrameSource.hpp"
 #include "samples/Progress.hpp"
+#include "sinks/BackgroundSink.hpp"
 #include "sinks/FrameSink.hpp"
 #include "sinks/ImageSinks.hpp"
 #include "sinks/V4l2OutputSink.hpp"
 #include "sources/DepthScale.hpp"
 #include "sources/FrameSource.hpp"
+#include "sources/ReadAheadSource.hpp"
 #include "sources/SyntheticSource.hpp"
 
 namespace {
@@ -343,6 +345,9 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         }
     } catch (const std::exception& error) {
         progress.finish();
+        // A write that failed on the writing thread is rethrown frames later: name its frame.
+        if (const auto* background = dynamic_cast<const BackgroundSink*>(&sink))
+            current = background->failedFrame().value_or(current);
         spdlog::error("frame {}: {}", current, error.what());
         status = cli::statusFor(error);
         if (report)
@@ -425,7 +430,16 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
     sinkOptions.linearSequence = options.imageFormat == "exr";
     sinkOptions.overwrite = options.overwrite;
     sinkOptions.codec = options.codec;
-    auto sink = openSink(sinkOptions);
+    std::unique_ptr<FrameSink> sink = openSink(sinkOptions);
+    // Files from a recorded clip: the next frames are decoded and the last ones encoded on
+    // threads of their own while the filter works (docs/benchmarks.md, "Reading and writing
+    // beside the filter"). Not a camera's frames (NewestFrameSource below takes the newest), not
+    // --demo's (rendered in the filter's GL context, on this thread), not a virtual camera's
+    // (due when made).
+    if (!source->isLive() && !demo)
+        source = std::make_unique<ReadAheadSource>(std::move(source));
+    if (!dynamic_cast<V4l2OutputSink*>(sink.get()))
+        sink = std::make_unique<BackgroundSink>(std::move(sink));
     // A camera to a virtual camera: never make the camera wait, drop what the filter cannot keep up with.
     NewestFrameSource* newest = nullptr;
     if (source->isLive() && dynamic_cast<V4l2OutputSink*>(sink.get())) {

@@ -1,0 +1,71 @@
+// A sink written on a thread of its own: while the filter works on the next frame, the last ones
+// are encoded and written (PNG encoding is single-threaded; at 1920x1080 a frame takes 50 ms).
+// Frames are written in the order given, all of them before finish() finalises the output.
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "sinks/FrameSink.hpp"
+
+namespace defocus {
+
+class BackgroundSink final : public FrameSink {
+public:
+    /// Writes to `sink` (a file output; not a window or a virtual camera, whose frames are due
+    /// when they are made) on its own thread, at most `depth` frames behind writeFrame() (>= 1).
+    explicit BackgroundSink(std::unique_ptr<FrameSink> sink, std::size_t depth = 2);
+    /// finish(), errors swallowed: call finish() to see them.
+    ~BackgroundSink() override;
+    BackgroundSink(const BackgroundSink&) = delete;
+    BackgroundSink& operator=(const BackgroundSink&) = delete;
+
+    SinkEncoding encoding() const override { return encoding_; }
+    /// Queues the frame (waiting while `depth` are queued) and returns. Rethrows the error of a
+    /// write that failed since the last call; once one has failed, nothing more is written.
+    void write(const cv::Mat& image) override;
+    void writeFrame(const cv::Mat& image, const Frame& origin) override;
+    /// Writes what is queued, then finalises the output. Rethrows the first error of a write
+    /// (not yet rethrown) or of finalising.
+    void finish() override;
+    /// Frames written (not queued) so far.
+    std::size_t framesWritten() const override;
+    /// The output's description, as of the last frame written.
+    std::string describe() const override;
+    /// The position (0 = the first frame given) of the frame whose write failed, if one did.
+    std::optional<std::size_t> failedFrame() const;
+
+private:
+    struct Job {
+        cv::Mat image;
+        std::optional<Frame> origin;
+    };
+    void enqueue(Job job);
+    void run();
+
+    std::unique_ptr<FrameSink> sink_;
+    const std::size_t depth_;
+    const SinkEncoding encoding_;
+    mutable std::mutex mutex_;
+    std::condition_variable changed_;
+    std::deque<Job> jobs_;
+    std::size_t given_ = 0;   // frames given to writeFrame()
+    std::size_t written_ = 0; // of them written
+    std::string describe_;
+    std::exception_ptr error_; // the failed write's, until rethrown
+    std::optional<std::size_t> failedFrame_;
+    bool writing_ = false;     // a job is out of jobs_ and being written
+    bool stopping_ = false;
+    bool finished_ = false;
+    std::thread thread_; // last: starts once everything above is made
+};
+
+} // namespace defocus
