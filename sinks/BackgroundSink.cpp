@@ -33,7 +33,6 @@ void BackgroundSink::run()
             return; // stopping, and all written
         Job job = std::move(jobs_.front());
         jobs_.pop_front();
-        writing_ = true;
         const bool failed = failedFrame_.has_value();
         lock.unlock();
         changed_.notify_all(); // room in the queue
@@ -51,7 +50,6 @@ void BackgroundSink::run()
             }
         }
         lock.lock();
-        writing_ = false;
         if (error) {
             error_ = error;
             failedFrame_ = written_;
@@ -74,7 +72,6 @@ void BackgroundSink::enqueue(Job job)
     if (failedFrame_)
         return; // failed before, and the caller was told: nothing more is written
     jobs_.push_back(std::move(job));
-    ++given_;
     lock.unlock();
     changed_.notify_all();
 }

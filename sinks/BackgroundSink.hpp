@@ -57,12 +57,10 @@ private:
     mutable std::mutex mutex_;
     std::condition_variable changed_;
     std::deque<Job> jobs_;
-    std::size_t given_ = 0;   // frames given to writeFrame()
-    std::size_t written_ = 0; // of them written
+    std::size_t written_ = 0; // frames written
     std::string describe_;
     std::exception_ptr error_; // the failed write's, until rethrown
     std::optional<std::size_t> failedFrame_;
-    bool writing_ = false;     // a job is out of jobs_ and being written
     bool stopping_ = false;
     bool finished_ = false;
     std::thread thread_; // last: starts once everything above is made
