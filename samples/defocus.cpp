@@ -431,18 +431,18 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
     sinkOptions.overwrite = options.overwrite;
     sinkOptions.codec = options.codec;
     std::unique_ptr<FrameSink> sink = openSink(sinkOptions);
-    // Files from a recorded clip: the next frames are decoded and the last ones encoded on
-    // threads of their own while the filter works (docs/benchmarks.md, "Reading and writing
-    // beside the filter"). Not a camera's frames (NewestFrameSource below takes the newest), not
-    // --demo's (rendered in the filter's GL context, on this thread), not a virtual camera's
-    // (due when made).
+    // While the filter works, a file output is encoded and written up to two frames behind and a
+    // recorded clip decoded up to two ahead, each on a thread of its own (docs/benchmarks.md,
+    // "Reading and writing beside the filter"); not a virtual camera's frames (due when made), nor
+    // --demo's (rendered in the filter's GL context, on this thread).
+    const bool virtualCamera = dynamic_cast<V4l2OutputSink*>(sink.get()) != nullptr;
+    if (!virtualCamera)
+        sink = std::make_unique<BackgroundSink>(std::move(sink));
     if (!source->isLive() && !demo)
         source = std::make_unique<ReadAheadSource>(std::move(source));
-    if (!dynamic_cast<V4l2OutputSink*>(sink.get()))
-        sink = std::make_unique<BackgroundSink>(std::move(sink));
     // A camera to a virtual camera: never make the camera wait, drop what the filter cannot keep up with.
     NewestFrameSource* newest = nullptr;
-    if (source->isLive() && dynamic_cast<V4l2OutputSink*>(sink.get())) {
+    if (source->isLive() && virtualCamera) {
         auto feed = std::make_unique<NewestFrameSource>(std::move(source), [] { return cli::stopRequested(); });
         newest = feed.get();
         source = std::move(feed);

@@ -85,16 +85,16 @@ int run(const Options& o)
     sourceOptions.height = o.camera.height;
     sourceOptions.fps = o.camera.fps;
     sourceOptions.pixelFormat = o.camera.pixelFormat;
+    std::unique_ptr<FrameSource> source = openSource(sourceOptions);
     // Cameras never block the preview; clips never drop a frame, and are decoded a frame or two
     // ahead on a thread of their own while the filter renders (sources/ReadAheadSource.hpp).
-    const auto open = [&] {
-        std::unique_ptr<FrameSource> opened = openSource(sourceOptions);
-        if (opened->isLive() || isVideoDevice(o.input))
-            return opened;
-        return std::unique_ptr<FrameSource>(std::make_unique<ReadAheadSource>(std::move(opened)));
-    };
-    std::unique_ptr<FrameSource> source = open();
     const bool live = source->isLive() || isVideoDevice(o.input);
+    const auto readAhead = [live](std::unique_ptr<FrameSource> opened) -> std::unique_ptr<FrameSource> {
+        if (live)
+            return opened;
+        return std::make_unique<ReadAheadSource>(std::move(opened));
+    };
+    source = readAhead(std::move(source));
     const double sourceFps = source->frameRate() > 0.0 ? source->frameRate() : 30.0;
 
     LiveControls controls;
@@ -172,7 +172,7 @@ int run(const Options& o)
                 } else if (feed->ended()) {
                     if (o.loop && !live && framesShown > 0) {
                         feed.reset();
-                        source = open();
+                        source = readAhead(openSource(sourceOptions));
                         feed = std::make_unique<FrameFeed>(*source, live);
                         previousTimestamp = 0.0;
                         continue;
