@@ -34,6 +34,7 @@
 // variants: llvmpipe pays for every instruction of a branch on a uniform. FUSED (second pass
 // only) writes the composite (A + 2B) / 3 itself, to one target: the output.
 #include "common.glsl"
+#include "rhombus_lines.glsl"
 
 layout(location = 0) out vec4 outFirst;
 #ifndef FUSED
@@ -65,32 +66,8 @@ layout(std140, binding = 0) uniform RhombusBlurParams {
 // sit in successive columns (or rows). A segment shorter than half a step is the centre alone
 // (|CoC| < 1 px leaves a pixel as it is), and the result moves continuously with the CoC: taps
 // sit at fixed offsets and only their weights change. Lines longer than maxTaps base steps space
-// the taps out; those taps move with the CoC and are always filtered (the `smooth` samplers).
-// Unfiltered taps off the axes make digital lines, and a second line off the axes crossing a
-// digital line hits it twice or never: a point light's hexagon came out striped. Lines that are
-// crossed that way later, and lines that cross them, take bilinear taps. Bilinear taps do not
-// cure it where both lines are off the axes (the third rhombus, u3 of u2): crossing a bilinear
-// line obliquely still depends on where it lies between texel centres (+-44 % on a point light,
-// measured with a CPU model of this shader). A pass-2 line over a pass-1 line, both off the axes
-// (PAIR), takes each tap as the mean of two, half a pixel to either side of it: +-8 %.
-// `mode` is a compile-time constant per line (LINE1_MODE to LINE3_MODE, set by RhombusBlurPass):
-// llvmpipe runs both sides of a branch that differs between pixels, so a run-time choice cost
-// every tap all of its fetches.
-const int POINT = 0;  // unfiltered (bilinear only for spread taps)
-const int SMOOTH = 1; // bilinear
-const int PAIR = 2;   // two bilinear taps, `across` to either side
-vec4 fetchTap(sampler2D source, sampler2D smoothSource, const int mode, vec2 coords, vec2 across, float smoothing)
-{
-    if (mode == PAIR)
-        return 0.5 * (textureLod(smoothSource, coords + across, 0.0) + textureLod(smoothSource, coords - across, 0.0));
-    if (mode == SMOOTH)
-        return textureLod(smoothSource, coords, 0.0);
-    vec4 tap = textureLod(source, coords, 0.0);
-    if (smoothing > 0.0)
-        tap = mix(tap, textureLod(smoothSource, coords, 0.0), smoothing);
-    return tap;
-}
-
+// the taps out; those taps move with the CoC and are always filtered (the `smooth` samplers;
+// rhombus_lines.glsl has how each line takes its taps).
 // One line, or with `both` two lines along the same direction over two sources whose texels
 // carry the same CoC (pass 2's u3 over X and over Z): the taps' weights come from the first
 // source's CoC and serve both, so the second costs only its fetches.
@@ -166,13 +143,8 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
         weight *= 1.0 - unreached * clamp(tapLuminance - 1.0, 0.0, 1.0);
         weight *= ownPiece;
 #ifdef NEAR_FIELD
-        // Foreground that reaches: soft over the last half pixel of its radius; a segment of
-        // length tapRadius scattered from the tap puts step / tapRadius of it on this pixel.
-        const float tapRadius = 0.5 * abs(tap.a);
-        const float reach = nearer && tapRadius > radius
-                                ? clamp(tapRadius - distance + 0.5, 0.0, 1.0) * clamp(length - float(k) + 0.5, 0.0, 1.0)
-                                : 0.0;
-        const float share = reach * step / max(tapRadius, 1e-3);
+        const float reach = foregroundReach(tap.a, center.a, radius, distance, float(k), length);
+        const float share = foregroundShare(reach, tap.a, step);
         foreground += tap.rgb * share;
         foreground2 += tap2 * share;
         coverage += share;

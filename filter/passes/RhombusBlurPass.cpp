@@ -138,25 +138,45 @@ RhombusBlurPass::Directions RhombusBlurPass::directions(float bladeRotationDeg)
     return {u1, u1 + 120.0f, u1 + 240.0f};
 }
 
+RhombusBlurPass::Lines RhombusBlurPass::lines(const Directions& d, int width, int height)
+{
+    const LineModes modes = lineModes(d);
+    const auto line = [&](float degrees, LineMode mode, bool pair) {
+        Line l{};
+        step(degrees, width, height, l.direction, l.baseStep);
+        if (pair)
+            halfPixelAcross(degrees, width, height, l.across);
+        l.mode = mode;
+        return l;
+    };
+    // u3's two lines share their offsets: either one taking pairs sets them for both.
+    const bool u3Pair = modes.second[1] == LineMode::Pair || modes.second[2] == LineMode::Pair;
+    return {line(d.u1, modes.first[0], modes.first[0] == LineMode::Pair),
+            line(d.u2, modes.first[1], modes.first[1] == LineMode::Pair),
+            line(d.u2, modes.second[0], modes.second[0] == LineMode::Pair),
+            line(d.u3, modes.second[1], u3Pair),
+            line(d.u3, modes.second[2], u3Pair)};
+}
+
 void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int taps, int tileSize,
                           const TileList* tiles, bool fused, bool unrolled)
 {
     assert(taps >= 1 && taps <= kMaxTaps);
     assert(first || io.sourceB);
     assert(!(first && fused));
-    const int width = io.target.width(), height = io.target.height();
-    const float line1 = first ? d.u1 : d.u2, line2 = first ? d.u2 : d.u3;
+    const Lines all = lines(d, io.target.width(), io.target.height());
+    const Line& line1 = first ? all.x : all.a;
+    const Line& line2 = first ? all.z : all.bOverZ;
+    const LineMode mode3 = all.bOverX.mode; // pass 2: u3 over X, the same direction as line 2
     Uniforms u{};
-    step(line1, width, height, &u.directions[0], u.baseSteps[0]);
-    step(line2, width, height, &u.directions[2], u.baseSteps[1]);
-    const LineModes modes = lineModes(d);
-    const LineMode mode1 = first ? modes.first[0] : modes.second[0];
-    const LineMode mode2 = first ? modes.first[1] : modes.second[1];
-    const LineMode mode3 = modes.second[2]; // pass 2: u3 over X, the same direction as line 2
-    if (mode1 == LineMode::Pair)
-        halfPixelAcross(line1, width, height, &u.across[0]);
-    if (mode2 == LineMode::Pair || (!first && mode3 == LineMode::Pair))
-        halfPixelAcross(line2, width, height, &u.across[2]);
+    std::copy_n(line1.direction, 2, &u.directions[0]);
+    std::copy_n(line2.direction, 2, &u.directions[2]);
+    std::copy_n(line1.across, 2, &u.across[0]);
+    std::copy_n(line2.across, 2, &u.across[2]);
+    u.baseSteps[0] = line1.baseStep;
+    u.baseSteps[1] = line2.baseStep;
+    const LineMode mode1 = line1.mode, mode2 = line2.mode;
+    const int height = io.target.height();
     u.nearTileSize = tileSize;
     u.bleedingBias = HexBlurPass::kBleedingBias;
     u.bleedingMult = HexBlurPass::kBleedingMult;

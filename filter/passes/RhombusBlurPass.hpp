@@ -33,6 +33,25 @@ public:
     };
     static Directions directions(float bladeRotationDeg);
 
+    /// How a line takes its taps (rhombus_lines.glsl): unfiltered, bilinear, or a bilinear pair.
+    enum class LineMode { Point = 0, Smooth = 1, Pair = 2 };
+    /// One line at a target's size: texture-space offset per pixel along it, half a pixel across
+    /// it (Pair lines only, else 0), the step that moves one pixel on its major axis (pixels),
+    /// and how it takes its taps.
+    struct Line {
+        float direction[2];
+        float across[2];
+        float baseStep;
+        LineMode mode;
+    };
+    /// Every line of the two passes for a target of width x height: pass 1's u1 and u2 over the
+    /// source (X, Z), pass 2's u2 over X (A), u3 over Z and u3 over X (B, the taps' weights
+    /// from X's). InFocusLightPass follows the same lines.
+    struct Lines {
+        Line x, z, a, bOverZ, bOverX;
+    };
+    static Lines lines(const Directions& directions, int width, int height);
+
     /// What a pass reads and writes. Pass 1 reads `sourceA` (the CoC target) and writes X, Z;
     /// pass 2 reads X as `sourceA` and Z as `sourceB` and writes A, B.
     struct Io {
@@ -65,8 +84,6 @@ private:
         float cocToPaperUnits;
         float bleedingRamp;
     };
-    /// How a line takes its taps (rhombus_blur.frag): unfiltered, bilinear, or a bilinear pair.
-    enum class LineMode { Point = 0, Smooth = 1, Pair = 2 };
     /// Pass 1: u1 and u2 of the source; pass 2: u2 over X, u3 over Z, u3 over X.
     struct LineModes {
         std::array<LineMode, 2> first;
