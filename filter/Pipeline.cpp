@@ -19,6 +19,7 @@
 #include "filter/passes/CopyPass.hpp"
 #include "filter/passes/HexBlurPass.hpp"
 #include "filter/passes/HighlightSpritePass.hpp"
+#include "filter/passes/InFocusLightPass.hpp"
 #include "filter/passes/RhombusBlurPass.hpp"
 #include "filter/passes/NearBlurPass.hpp"
 #include "filter/passes/UpscalePass.hpp"
@@ -101,6 +102,7 @@ struct Pipeline::Impl {
     gl::VertexArray vao = gl::VertexArray::create();
     CocPass cocPass;
     HighlightSpritePass highlightSpritePass;
+    InFocusLightPass inFocusLightPass;
     HexBlurPass hexBlurPass;
     RhombusBlurPass rhombusBlurPass;
     CompositePass compositePass;
@@ -111,6 +113,7 @@ struct Pipeline::Impl {
     TileList blurTiles, copyTiles, nearTiles;
     TileList detailTiles; ///< Resolution::Half: where the upscale puts the frame's detail back
     TileList highlightTiles; ///< where the CoC pass treats highlights pixel by pixel
+    TileList frameHighlightTiles; ///< the same tiles in the frame's pixels (InFocusLightPass)
     gl::StorageBuffer neighbourhoods; ///< SceneAnalysis::tileNeighbourhood, for the bokeh sprites
     bool upscaleUsesTiles = false;
     gl::GpuTimer timer;
@@ -441,7 +444,8 @@ void Pipeline::Impl::upscale(const gl::Framebuffer& out)
     timer.end();
     timer.begin(UpscalePass::kName);
     upscalePass.upscale(io, coefficients, quality.targetFormat == TargetFormat::Rgba16F, blurShift,
-                        upscaleUsesTiles ? &detailTiles : nullptr);
+                        upscaleUsesTiles ? &detailTiles : nullptr,
+                        plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f);
     timer.end();
 }
 
@@ -562,6 +566,17 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
     if (view == View::Composite && p.plan.highlightSprites) {
         p.timer.begin(HighlightSpritePass::kName);
         p.highlightSpritePass.draw(p.depth, out.framebuffer);
+        p.timer.end();
+        // The light the CoC pass held back from pixels in focus goes back (sprites never run at
+        // quarter size).
+        p.timer.begin(InFocusLightPass::kName);
+        const bool half = p.quality.targetFormat == TargetFormat::Rgba16F;
+        p.frameHighlightTiles.set(p.analysis.highlightTiles, p.size, SceneAnalysis::kTileSize);
+        p.inFocusLightPass.run({p.colorTexture, p.depth, p.coc.texture, p.plan.nearField ? &p.nearDiameter : nullptr},
+                               CocPass::uniforms(p.coefficients, half, static_cast<float>(p.plan.highlightGain),
+                                                 HighlightSpritePass::kThreshold),
+                               RhombusBlurPass::directions(p.bladeRotationDeg), p.quality.samples, p.tileSize(),
+                               p.blurShift, p.frameHighlightTiles, out.framebuffer);
         p.timer.end();
     }
 

@@ -17,8 +17,8 @@
 // that treats highlights pixel by pixel before the mean, drawn only on the tiles that have
 // highlights, over the plain variant's texels (CocPass). SPRITES (bokeh sprites,
 // highlightThreshold > 0): a pixel's light above the threshold leaves the gather for its sprite,
-// and at half or quarter size a light in focus enters it at white's worth at most; compiled out
-// of the other variants, where llvmpipe would run it for every pixel.
+// and a light in focus enters it at white's worth at most; compiled out of the other variants,
+// where llvmpipe would run it for every pixel.
 #include "common.glsl"
 #include "coc_params.glsl"
 #include "highlights.glsl"
@@ -45,17 +45,16 @@ vec4 pixel(ivec2 texel)
     const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
     const vec3 color = blurColor(raw, coc);
     const bool drawn = spriteHeader[5] <= spriteHeader[4];
-#if defined(HALF_SIZE) || defined(QUARTER_SIZE)
-    // A light in focus goes into the blur at white's worth at most: the upscale puts the frame's
-    // own pixel back where it is in focus (upscale.frag), so the light keeps its brightness, but
-    // in the mean of a half-size block and in the bilinear taps of the blur around it, its HDR
-    // value took the background's CoC and lit the background's blur, a halo as large as that
-    // blur (3.9-4.3 % of such a light outside its own pixels; 1.2-1.4 % kept to white's worth).
-    // The corpus: railing-lights 28.14 -> 31.78 dB balanced, spheres-near-focus 31.99 -> 35.89.
-    // Not at full size, where the blur's output is the pixel itself.
+    // A light in focus goes into the blur at white's worth at most. In a half-size block's mean
+    // and in the bilinear taps of the blur around it, its HDR value took the background's CoC and
+    // lit the background's blur, a halo as large as that blur (3.9-4.3 % of such a light outside
+    // its own pixels at half size; 1.2-1.4 % kept to white's worth), and the upscale's frame +
+    // bil(R - C) drew its block square. The light keeps its brightness: at half size the upscale
+    // puts the frame's pixel back where it is in focus (upscale.frag), at full size
+    // InFocusLightPass adds back what the blur left of it (in_focus_light.frag). The corpus:
+    // railing-lights 28.14 -> 31.78 dB balanced, spheres-near-focus 31.99 -> 35.89.
     if (abs(coc) < 1.0)
         return vec4(color * min(1.0, highlightThreshold / max(luminance(color), 1e-6)), coc);
-#endif
     return vec4(drawn ? color * spriteShare(color, coc, texel, textureSize(uColor, 0)) : color, coc);
 #else
     const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);

@@ -43,7 +43,12 @@ void main()
     const float w = clamp((DETAIL_BELOW_PX - abs(coc)) / (0.5 * DETAIL_BELOW_PX), 0.0, 1.0);
     vec3 result = interpolated;
     if (w > 0.0) {
-        const vec3 frame = sanitizeColor(texelFetch(uColor, texel, 0).rgb, largestColor);
+        vec3 frame = sanitizeColor(texelFetch(uColor, texel, 0).rgb, largestColor);
+        // Frames with bokeh sprites: a light in focus entered the blur at white's worth
+        // (coc.frag), and so it is kept here; InFocusLightPass adds the rest by the share of the
+        // pixel that no blurred foreground covers (in_focus_light.frag).
+        if (highlightThreshold > 0.0 && abs(coc) < 1.0)
+            frame *= min(1.0, highlightThreshold / max(luminance(frame), 1e-6));
         const vec3 kept = frame + textureLod(uAdded, uv, 0.0).rgb;
         // Not mix() at w = 1: x + 1 * (y - x) need not be y to the last bit.
         result = max(w >= 1.0 ? kept : interpolated + w * (kept - interpolated), vec3(0.0));

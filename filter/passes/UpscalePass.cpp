@@ -56,10 +56,10 @@ void UpscalePass::prefilter(const Io& io)
 }
 
 void UpscalePass::upscale(const Io& io, const CocCoefficients& k, bool halfTarget, int sizeShift,
-                          const TileList* detailTiles)
+                          const TileList* detailTiles, float highlightThreshold)
 {
     Programs& programs = sizeShift == 2 ? quarter_ : half_;
-    const CocPass::Uniforms u = CocPass::uniforms(k, halfTarget, 1.0f);
+    const CocPass::Uniforms u = CocPass::uniforms(k, halfTarget, 1.0f, highlightThreshold);
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
     io.target.bindForDraw();

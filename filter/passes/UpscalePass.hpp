@@ -36,9 +36,11 @@ public:
     /// The prefilter (half size, into io.prefiltered), then the upscale (into io.target); the
     /// pipeline times them apart.
     void prefilter(const Io& io);
-    /// `sizeShift`: 1 when the blur ran at half size, 2 at quarter size.
+    /// `sizeShift`: 1 when the blur ran at half size, 2 at quarter size. `highlightThreshold` > 0
+    /// (frames with bokeh sprites): the CoC pass's, whose cap on a light in focus the frame's
+    /// pixels keep here (InFocusLightPass puts the rest back).
     void upscale(const Io& io, const CocCoefficients& k, bool halfTarget, int sizeShift,
-                 const TileList* detailTiles = nullptr);
+                 const TileList* detailTiles = nullptr, float highlightThreshold = 0.0f);
 
 private:
     struct Programs {
