@@ -27,8 +27,9 @@ void main()
     const float radius = 0.5 * abs(sprite.z);
     const float area = sprite.w; // hexagonArea(radius), once per sprite (highlight_sprites.comp)
     // Instances 1 to 3: the sprite mirrored in the nearer vertical edge, horizontal edge, or both,
-    // so that light a hexagon would carry out of the frame comes back in, as the gather reads the
-    // frame mirrored beyond its edges (and a bright region keeps its level up to the edges).
+    // so that light a hexagon would carry out of the frame comes back in, as the lights that lie
+    // beyond it would bring theirs (and a bright region keeps its level up to the edges, as the
+    // gather, which repeats the edge pixels, keeps it).
     // Mirror images that do not reach into the frame are collapsed to a point.
     const float reach = radius + 0.81;
     const int mirror = gl_InstanceID & 3;

@@ -290,7 +290,7 @@ TEST_F(HalfSize, QuarterSizeBlurMatchesTheHalfSizeBlur)
     const cv::Mat half = halfPipeline.run(frame, lens, halfOnly, View::Composite, Encoding::Linear32F);
     ASSERT_EQ(quarterPipeline.plan().blurShift, 2);
     ASSERT_EQ(halfPipeline.plan().blurShift, 1);
-    const cv::Rect inside(24, 24, 112, 80); // away from the borders' mirroring
+    const cv::Rect inside(24, 24, 112, 80); // away from the borders' repeated edge
     cv::Mat diff;
     cv::absdiff(encodeSrgb(quarter(inside)), encodeSrgb(half(inside)), diff);
     const cv::Scalar meanDiff = cv::mean(diff);

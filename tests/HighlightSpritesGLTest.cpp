@@ -118,7 +118,7 @@ TEST_F(HighlightSprites, ALightFillingAThirdOfItsNeighbourhoodMakesSprites)
 TEST_F(HighlightSprites, ALightAtTheEdgeKeepsItsEnergyInTheFrame)
 {
     // 2 px from the left edge, a 30 px hexagon: most of it would fall outside; the sprite's
-    // mirror image brings it back, as the gather reads the frame mirrored.
+    // mirror image brings it back, as lights beyond the frame would bring theirs.
     const cv::Mat color = light({2, 48}, 1000.0f);
     const cv::Mat far(color.size(), CV_32F, cv::Scalar(2.0f));
     Pipeline pipeline;
@@ -198,7 +198,7 @@ TEST_F(HighlightSprites, ALightInFrontOfABlurredBackgroundIsNotDrawnASecondTimeB
         cv::Mat depth(size, CV_32F, cv::Scalar(2.0f)); // +30 px of CoC
         color(square).setTo(cv::Scalar::all(level));
         depth(square).setTo(c.depthM);
-        double energy = level * square.area();
+        double energy = level * static_cast<double>(square.area());
         if (c.edge) {
             const cv::Rect ring{square.x - 1, square.y - 1, square.width + 2, square.height + 2};
             for (int y = ring.y; y < ring.br().y; ++y)

@@ -12,12 +12,13 @@
 
 namespace defocus {
 
-// The blur reads beyond the frame mirrored; the coverage must read the same taps.
+// The blur reads beyond the frame its edge repeated (RhombusBlurPass); the coverage must read the
+// same taps.
 InFocusLightPass::InFocusLightPass()
     : cocParams_(sizeof(CocPass::Uniforms), "lights in focus coc params"),
       uniforms_(sizeof(Uniforms), "lights in focus params"),
-      nearest_(GL_NEAREST, "lights in focus nearest", GL_MIRRORED_REPEAT),
-      linear_(GL_LINEAR, "lights in focus linear", GL_MIRRORED_REPEAT)
+      nearest_(GL_NEAREST, "lights in focus nearest", GL_CLAMP_TO_EDGE),
+      linear_(GL_LINEAR, "lights in focus linear", GL_CLAMP_TO_EDGE)
 {
 }
 

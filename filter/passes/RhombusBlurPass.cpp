@@ -65,14 +65,17 @@ RhombusBlurPass::LineModes RhombusBlurPass::lineModes(const Directions& d)
     };
 }
 
-// Taps beyond the frame read it mirrored: where the edge pixels were repeated instead, a pixel
-// at the edge took a third to a half of its blur from them alone. On the Blender scene the 8 px
-// next to the edges measured 30.6 dB against the truth, clamped, and 32.6 dB mirrored (the rest
-// of the frame 34.8); the whole frame +0.22 dB at full size, +0.15 at half.
+// Taps beyond the frame read its edge pixels repeated: the scene goes on beyond the frame as it
+// is at the edge. Read mirrored instead (chosen first, on the Blender scene alone), a gradient
+// into the edge turned back and a structure along it (a wall's mortar line in the edge row) was
+// reflected away; on the corpus the 8 px next to the edges measured better repeated on eight
+// scenes of nine (near-object 25.1 -> 39.3 dB high, spheres-near-focus 38.6 -> 43.8,
+// overlapping-lights 21.9 -> 24.6), worse on the Blender scene (32.4 -> 30.5), and the
+// corpus's minimum and median rose for every preset (docs/accuracy.md).
 RhombusBlurPass::RhombusBlurPass()
     : uniforms_(sizeof(Uniforms), "rhombus blur params"),
-      linear_(GL_LINEAR, "rhombus blur linear", GL_MIRRORED_REPEAT),
-      nearest_(GL_NEAREST, "rhombus blur nearest", GL_MIRRORED_REPEAT)
+      linear_(GL_LINEAR, "rhombus blur linear", GL_CLAMP_TO_EDGE),
+      nearest_(GL_NEAREST, "rhombus blur nearest", GL_CLAMP_TO_EDGE)
 {
     // The variants of the default rotation (a corner on top), so that no frame pays for them.
     const LineModes modes = lineModes(directions(0.0f));
