@@ -17,8 +17,8 @@
 // that treats highlights pixel by pixel before the mean, drawn only on the tiles that have
 // highlights, over the plain variant's texels (CocPass). SPRITES (bokeh sprites,
 // highlightThreshold > 0): a pixel's light above the threshold leaves the gather for its sprite,
-// and a light in focus enters it at white's worth at most; compiled out of the other variants,
-// where llvmpipe would run it for every pixel.
+// and a light in focus enters it as what lies round it; compiled out of the other variants, where
+// llvmpipe would run it for every pixel.
 #include "common.glsl"
 #include "coc_params.glsl"
 #include "highlights.glsl"
@@ -45,17 +45,17 @@ vec4 pixel(ivec2 texel)
     const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
     const vec3 color = blurColor(raw, coc);
     const bool drawn = spriteHeader[5] <= spriteHeader[4];
-    // A light in focus goes into the blur at white's worth at most. In a half-size block's mean
-    // and in the bilinear taps of the blur around it, its HDR value took the background's CoC and
-    // lit the background's blur, a halo as large as that blur (3.9-4.3 % of such a light outside
-    // its own pixels at half size; 1.2-1.4 % kept to white's worth), and the upscale's frame +
-    // bil(R - C) drew its block square. The light keeps its brightness: InFocusLightPass adds the
-    // rest back after the blur, by the share of the pixel no blurred foreground covers
-    // (in_focus_light.frag; at half size the upscale keeps the capped pixel for it). The corpus:
-    // railing-lights 28.14 -> 31.78 dB balanced, spheres-near-focus 31.99 -> 35.89; at full size
-    // railing-lights 29.22 -> 31.82 high.
+    // A light in focus goes into the blur as what lies round it (standIn(), highlights.glsl). In
+    // a half-size block's mean and in the bilinear taps of the blur around it, its HDR value took
+    // the background's CoC and lit the background's blur, a halo as large as that blur (3.9-4.3 %
+    // of such a light outside its own pixels at half size; 1.0-1.4 % with the light at white's
+    // worth; none with the stand-in), and the upscale's frame + bil(R - C) drew its block square.
+    // The light keeps its brightness: InFocusLightPass adds the rest back after the blur, by the
+    // share of the pixel no blurred foreground covers (in_focus_light.frag; at half size the
+    // upscale keeps the stand-in for it). The corpus (docs/accuracy.md): railing-lights 28.14 ->
+    // 31.78 dB balanced with white's worth, 32.15 with the stand-in; tele-135-f8 39.64 -> 40.99.
     if (abs(coc) < 1.0)
-        return vec4(color * min(1.0, highlightThreshold / max(luminance(color), 1e-6)), coc);
+        return vec4(luminance(color) > highlightThreshold ? standIn(uColor, texel, color) : color, coc);
     return vec4(drawn ? color * spriteShare(color, coc, texel, textureSize(uColor, 0)) : color, coc);
 #else
     const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);

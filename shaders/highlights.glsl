@@ -20,6 +20,28 @@ vec3 blurColor(vec3 color, float coc)
     return sanitizeColor(recoverHighlight(color, coc), largestColor);
 }
 
+// What a light in focus (|CoC| < 1 px, luminance above the threshold) enters the blur as, on
+// frames with bokeh sprites (coc.frag; upscale.frag and in_focus_light.frag take the same): the
+// mean of the pixels round it, 4 px away, that are not above the threshold (what lies behind the
+// light), or, where none is, the light scaled to the threshold's luminance. At white's worth
+// instead (the light scaled everywhere), its bilinear taps still left 1.0-1.4 % of it in the
+// blur of the background round it, a faint disc (HighlightSpritesGLTest).
+vec3 standIn(sampler2D colors, ivec2 texel, vec3 color)
+{
+    const ivec2 last = textureSize(colors, 0) - 1;
+    const ivec2 ring[8] = ivec2[8](ivec2(4, 0), ivec2(-4, 0), ivec2(0, 4), ivec2(0, -4), ivec2(3, 3), ivec2(-3, 3),
+                                   ivec2(3, -3), ivec2(-3, -3));
+    vec3 sum = vec3(0.0);
+    float count = 0.0;
+    for (int i = 0; i < 8; ++i) {
+        const vec3 c = sanitizeColor(texelFetch(colors, clamp(texel + ring[i], ivec2(0), last), 0).rgb, largestColor);
+        const bool dark = luminance(c) <= highlightThreshold;
+        sum += dark ? c : vec3(0.0);
+        count += dark ? 1.0 : 0.0;
+    }
+    return count > 0.0 ? sum / count : color * min(1.0, highlightThreshold / max(luminance(color), 1e-6));
+}
+
 // The neighbourhood a light is judged in: the 3x3 tiles of 16x16 px around the pixel's own
 // (48x48 px), clamped to the frame, summed on the CPU (SceneAnalysis::tileNeighbourhood): their
 // pixels, how many of them are above white, their luminance summed. One tile was too small for

@@ -1,11 +1,12 @@
 #version 450 core
 // Lights in focus put back, on frames with bokeh sprites (InFocusLightPass). The CoC pass lets a
-// light in focus (|CoC| < 1 px) into the blur at white's worth at most (coc.frag, SPRITES), so
-// that its HDR value does not light the blur around it; drawn additively over the output on the
-// tiles with highlights, this pass adds the rest of that light, E = light - capped, by the share
-// of the pixel that the blur left its own. At full size the blur's output of such a pixel is that
-// share of the capped light; at half size the upscale keeps the capped frame pixel plus what the
-// blur added to its texel (upscale.frag), and the share is the blur's at that texel.
+// light in focus (|CoC| < 1 px, above the highlight threshold) into the blur as what lies round
+// it, its stand-in (coc.frag, SPRITES; standIn() in highlights.glsl), so that its HDR value does
+// not light the blur around it; drawn additively over the output on the tiles with highlights,
+// this pass adds E = light - stand-in by the share of the pixel that the blur left its own. At
+// full size the blur's output of such a pixel is that share of the stand-in; at half size the
+// upscale keeps the stand-in plus what the blur added to its texel (upscale.frag), and the share
+// is the blur's at that texel.
 //
 // The rhombus blur (rhombus_blur.frag) returns an in-focus pixel as it is unless a blurred
 // foreground reaches it (NEAR_FIELD); then each line gives alpha F + (1 - alpha) centre, where
@@ -69,12 +70,12 @@ void main()
     const ivec2 texel = ivec2(gl_FragCoord.xy);
     const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);
     const vec3 color = blurColor(texelFetch(uColor, texel, 0).rgb, coc);
-    // coc.frag's cap, to the bit: what the blur was given.
-    const vec3 capped = color * min(1.0, highlightThreshold / max(luminance(color), 1e-6));
     if (abs(coc) >= 1.0 || luminance(color) <= highlightThreshold) {
         outColor = vec4(0.0);
         return;
     }
+    // coc.frag's stand-in, to the bit: what the blur was given.
+    const vec3 given = standIn(uColor, texel, color);
     float share = 1.0;
     if (nearField != 0) {
         // The blur's own view of the pixel: the CoC as its target holds it (a half float in
@@ -91,5 +92,5 @@ void main()
             share = ((1.0 - aA) * (1.0 - aX) + (1.0 - aB) * (1.0 - aX) + (1.0 - aB) * (1.0 - aZ)) / 3.0;
         }
     }
-    outColor = vec4(share * (color - capped), 0.0);
+    outColor = vec4(share * (color - given), 0.0);
 }

@@ -18,6 +18,7 @@
 // llvmpipe runs a branch's body for every pixel, so an `if` would not spare them the fetches.)
 #include "common.glsl"
 #include "coc_params.glsl"
+#include "highlights.glsl"
 
 layout(location = 0) out vec4 outColor;
 
@@ -44,11 +45,11 @@ void main()
     vec3 result = interpolated;
     if (w > 0.0) {
         vec3 frame = sanitizeColor(texelFetch(uColor, texel, 0).rgb, largestColor);
-        // Frames with bokeh sprites: a light in focus entered the blur at white's worth
-        // (coc.frag), and so it is kept here; InFocusLightPass adds the rest by the share of the
+        // Frames with bokeh sprites: a light in focus entered the blur as its stand-in (coc.frag,
+        // standIn()), and so it is kept here; InFocusLightPass adds the rest by the share of the
         // pixel that no blurred foreground covers (in_focus_light.frag).
         if (highlightThreshold > 0.0 && abs(coc) < 1.0)
-            frame *= min(1.0, highlightThreshold / max(luminance(frame), 1e-6));
+            frame = luminance(frame) > highlightThreshold ? standIn(uColor, texel, frame) : frame;
         const vec3 kept = frame + textureLod(uAdded, uv, 0.0).rgb;
         // Not mix() at w = 1: x + 1 * (y - x) need not be y to the last bit.
         result = max(w >= 1.0 ? kept : interpolated + w * (kept - interpolated), vec3(0.0));

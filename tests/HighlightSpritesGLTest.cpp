@@ -229,13 +229,13 @@ TEST_F(HighlightSprites, ALightInFrontOfABlurredBackgroundIsNotDrawnASecondTimeB
             EXPECT_LT(stray, 0.1) << c.name << ", " << preset.name;
             // In focus: a tap above white that its own blur does not bring here is hidden, not
             // lit (counted as white's worth instead, it left 7.4-7.6 % of the light outside its
-            // reach, 3.3 % at full size), and the light enters the blur at white's worth
-            // (coc.frag): 1.2-1.4 % at half size against 3.9-4.3 % with all of it, 1.0 % at full
-            // size against 1.6 %. The light's own pixels keep their brightness: the upscale
-            // (half size) and InFocusLightPass put them back.
+            // reach, 3.3 % at full size), and the light enters the blur as what lies round it
+            // (coc.frag, standIn()): 0.000 at every preset, against 3.9-4.3 % at half size with
+            // all of the light and 1.0-1.4 % with white's worth of it (1.6 % and 1.0 % at full
+            // size). The light's own pixels keep their brightness: InFocusLightPass puts them
+            // back.
             if (c.depthM == 0.99f) {
-                const bool half = preset.quality.resolution == Resolution::Half;
-                EXPECT_LT(stray, half ? 0.025 : 0.013) << c.name << ", " << preset.name;
+                EXPECT_LT(stray, 0.005) << c.name << ", " << preset.name;
                 const double kept = cv::mean(gray(square))[0] / level;
                 std::printf("[ FIGURE   ] %s, %s: the light's own pixels at %.4f of their level\n", c.name,
                             preset.name.c_str(), kept);

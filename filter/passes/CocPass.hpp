@@ -22,7 +22,8 @@ public:
     /// its CoC in half-size pixels; 2: ((w + 3) / 4, (h + 3) / 4), 4x4 pixels, quarter-size ones.
     /// `highlightThreshold` > 0: blurred pixels brighter than this that stand out of their tile
     /// keep only that much luminance (their rest goes to bokeh sprites, HighlightSpritePass), and
-    /// so do pixels in focus (|CoC| < 1 px; InFocusLightPass puts the rest back);
+    /// such pixels in focus (|CoC| < 1 px) enter the blur as what lies round them (standIn() in
+    /// highlights.glsl; InFocusLightPass puts the light back);
     /// `neighbourhoods` then holds SceneAnalysis::tileNeighbourhood (highlights.glsl) and `sprites`
     /// the sprites found (HighlightSpritePass::sprites()), whose count says whether they fit.
     /// Either of the two (or `sizeShift` > 0 with `highlightGain` > 1) needs `highlightTiles`,

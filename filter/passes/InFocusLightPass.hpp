@@ -1,6 +1,6 @@
-// Lights in focus put back: the CoC pass lets a light in focus into the blur at white's worth at
-// most (coc.frag, bokeh sprites' frames), and this pass adds the rest of it to the output, by
-// the share of the pixel that the blur left its own (under a blurred foreground, less). Shader:
+// Lights in focus put back: the CoC pass lets a light in focus into the blur as what lies round
+// it (coc.frag, bokeh sprites' frames), and this pass adds the rest of it to the output, by the
+// share of the pixel that the blur left its own (under a blurred foreground, less). Shader:
 // in_focus_light.frag.
 #pragma once
 
