@@ -52,15 +52,13 @@ layout(std140, binding = 2) uniform InFocusLightParams {
 float coverage(const int mode, vec4 line, float baseStep, vec2 uv, float centerCoc, float extent)
 {
     const float radius = 0.5 * abs(centerCoc);
-    const float step = max(baseStep, extent / float(maxTaps));
-    const float length = extent / step;
-    const int taps = int(ceil(length - 0.5));
-    const float smoothing = clamp((step / baseStep - 1.0) * 4.0, 0.0, 1.0);
+    const LineSteps s = lineSteps(baseStep, extent, float(maxTaps));
     float sum = 0.0;
-    for (int k = 1; k <= taps; ++k) {
-        const float distance = float(k) * step;
-        const float tapCoc = fetchTap(uCoc, uCocSmooth, mode, uv + line.xy * distance, line.zw, smoothing).a;
-        sum += foregroundShare(foregroundReach(tapCoc, centerCoc, radius, distance, float(k), length), tapCoc, step);
+    for (int k = 1; k <= s.taps; ++k) {
+        const float distance = float(k) * s.step;
+        const float tapCoc = fetchTap(uCoc, uCocSmooth, mode, uv + line.xy * distance, line.zw, s.smoothing).a;
+        sum += foregroundShare(foregroundReach(tapCoc, centerCoc, radius, distance, float(k), s.length), tapCoc,
+                               s.step);
     }
     return clamp(sum, 0.0, 1.0);
 }

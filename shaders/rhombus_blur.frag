@@ -86,14 +86,13 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
     const vec2 uv = pixelUv();
     const float radius = 0.5 * abs(center.a);
     const float centerBlur = abs(center.a) * cocToPaperUnits;
-    const float step = max(baseStep, extent / float(MAX_TAPS));
-    const float length = extent / step;       // in steps
-    const float ownLength = radius / step;    // the centre's own blur, in steps
-    const float halfPerStep = 0.5 / step;     // a CoC diameter to a radius in steps
-    const int taps = int(ceil(length - 0.5)); // pieces k >= 1 that start inside the segment
-    // Spread taps leave the lattice and are filtered; the switch fades over the first quarter
-    // of a step so that the output stays continuous in the CoC.
-    const float smoothing = clamp((step / baseStep - 1.0) * 4.0, 0.0, 1.0);
+    const LineSteps steps = lineSteps(baseStep, extent, float(MAX_TAPS));
+    const float step = steps.step;
+    const float length = steps.length;       // in steps
+    const float ownLength = radius / step;   // the centre's own blur, in steps
+    const float halfPerStep = 0.5 / step;    // a CoC diameter to a radius in steps
+    const int taps = steps.taps;             // pieces k >= 1 that start inside the segment
+    const float smoothing = steps.smoothing; // spread taps leave the lattice and are filtered
 
     float backgroundWeight = min(ownLength, 0.5);
     vec3 background = center.rgb * backgroundWeight;

@@ -27,6 +27,26 @@ vec4 fetchTap(sampler2D source, sampler2D smoothSource, const int mode, vec2 coo
     return tap;
 }
 
+// How a line of length `extent` (pixels) is stepped, at most `maxTaps` taps: the base step, or
+// longer where the line needs more taps than that; its length in steps; the taps k >= 1 whose
+// pieces start inside it; and how far the spread taps have left the lattice (filtered taps fade
+// in over the first quarter of a step, so that the output stays continuous in the CoC).
+struct LineSteps {
+    float step;
+    float length;
+    int taps;
+    float smoothing;
+};
+LineSteps lineSteps(float baseStep, float extent, float maxTaps)
+{
+    LineSteps s;
+    s.step = max(baseStep, extent / maxTaps);
+    s.length = extent / s.step;
+    s.taps = int(ceil(s.length - 0.5));
+    s.smoothing = clamp((s.step / baseStep - 1.0) * 4.0, 0.0, 1.0);
+    return s;
+}
+
 // NEAR_FIELD, "scatter as gather" (Jimenez 2014): how far a nearer tap blurrier than this pixel
 // reaches it, tap k (`distance` pixels away) of a line `length` steps long: soft over the last
 // half pixel of the tap's radius.
