@@ -55,7 +55,7 @@ vec4 pixel(ivec2 texel)
     // upscale keeps the stand-in for it). The corpus (docs/accuracy.md): railing-lights 28.14 ->
     // 31.78 dB balanced with white's worth, 32.15 with the stand-in; tele-135-f8 39.64 -> 40.99.
     if (abs(coc) < 1.0)
-        return vec4(luminance(color) > highlightThreshold ? standIn(uColor, texel, color) : color, coc);
+        return vec4(standIn(uColor, texel, color), coc);
     return vec4(drawn ? color * spriteShare(color, coc, texel, textureSize(uColor, 0)) : color, coc);
 #else
     const float coc = signedCoc(texelFetch(uDepth, texel, 0).r);

@@ -20,14 +20,17 @@ vec3 blurColor(vec3 color, float coc)
     return sanitizeColor(recoverHighlight(color, coc), largestColor);
 }
 
-// What a light in focus (|CoC| < 1 px, luminance above the threshold) enters the blur as, on
-// frames with bokeh sprites (coc.frag; upscale.frag and in_focus_light.frag take the same): the
-// mean of the pixels round it, 4 px away, that are not above the threshold (what lies behind the
-// light), or, where none is, the light scaled to the threshold's luminance. At white's worth
-// instead (the light scaled everywhere), its bilinear taps still left 1.0-1.4 % of it in the
-// blur of the background round it, a faint disc (HighlightSpritesGLTest).
+// What a pixel in focus (|CoC| < 1 px) of `colors` enters the blur as, on frames with bokeh
+// sprites (coc.frag; upscale.frag and in_focus_light.frag take the same): itself, or if it is a
+// light (luminance above the threshold) a stand-in: the mean of the pixels round it, 4 px away,
+// that are not above the threshold (what lies behind the light), or, where none is, the light
+// scaled to the threshold's luminance. At white's worth instead (the light scaled everywhere),
+// its bilinear taps still left 1.0-1.4 % of it in the blur of the background round it, a faint
+// disc (HighlightSpritesGLTest).
 vec3 standIn(sampler2D colors, ivec2 texel, vec3 color)
 {
+    if (luminance(color) <= highlightThreshold)
+        return color;
     const ivec2 last = textureSize(colors, 0) - 1;
     const ivec2 ring[8] = ivec2[8](ivec2(4, 0), ivec2(-4, 0), ivec2(0, 4), ivec2(0, -4), ivec2(3, 3), ivec2(-3, 3),
                                    ivec2(3, -3), ivec2(-3, -3));

@@ -72,7 +72,7 @@ void main()
         outColor = vec4(0.0);
         return;
     }
-    // coc.frag's stand-in, to the bit: what the blur was given.
+    // What the blur was given, as coc.frag gave it.
     const vec3 given = standIn(uColor, texel, color);
     float share = 1.0;
     if (nearField != 0) {

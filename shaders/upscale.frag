@@ -49,7 +49,7 @@ void main()
         // standIn()), and so it is kept here; InFocusLightPass adds the rest by the share of the
         // pixel that no blurred foreground covers (in_focus_light.frag).
         if (highlightThreshold > 0.0 && abs(coc) < 1.0)
-            frame = luminance(frame) > highlightThreshold ? standIn(uColor, texel, frame) : frame;
+            frame = standIn(uColor, texel, frame);
         const vec3 kept = frame + textureLod(uAdded, uv, 0.0).rgb;
         // Not mix() at w = 1: x + 1 * (y - x) need not be y to the last bit.
         result = max(w >= 1.0 ? kept : interpolated + w * (kept - interpolated), vec3(0.0));
