@@ -490,6 +490,8 @@ void Pipeline::Impl::render()
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
     if (plan.highlightSprites || plan.highlightGain > 1.0)
         highlightTiles.set(analysis.highlightTiles, blurSize, tileSize());
+    if (plan.highlightSprites)
+        frameHighlightTiles.set(analysis.highlightTiles, size, SceneAnalysis::kTileSize);
     cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
                 blurShift, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
                 &neighbourhoods, &highlightSpritePass.sprites(), &highlightTiles);
@@ -571,7 +573,6 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
         // quarter size).
         p.timer.begin(InFocusLightPass::kName);
         const bool half = p.quality.targetFormat == TargetFormat::Rgba16F;
-        p.frameHighlightTiles.set(p.analysis.highlightTiles, p.size, SceneAnalysis::kTileSize);
         p.inFocusLightPass.run({p.colorTexture, p.depth, p.coc.texture, p.plan.nearField ? &p.nearDiameter : nullptr},
                                CocPass::uniforms(p.coefficients, half, static_cast<float>(p.plan.highlightGain),
                                                  HighlightSpritePass::kThreshold),
