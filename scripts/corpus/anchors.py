@@ -3,8 +3,10 @@
 # (blender_defocus.py, calibrated) and GEGL's lens-blur driven by the thin-lens CoC of the
 # scene's depth, written as ANCHORS/SCENE/{blender-defocus,gegl-lens-blur}.exr (linear) for
 #   defocus-bench accuracy --scene ... --anchors ANCHORS
-# Needs blender and gegl (Debian 12 packages; for measuring only, not to build defocus).
-#   scripts/corpus/anchors.py [--out out/corpus_anchors] SCENE_OR_CORPUS_DIR...
+# Both get the CoC of the truth's camera (thinlens.py, the filter's thin-lens model). Needs blender
+# and gegl (Debian 12 packages; for measuring only, not to build defocus), or only the one named
+# with --tool.
+#   scripts/corpus/anchors.py [--out out/corpus_anchors] [--tool gegl|blender] SCENE_OR_CORPUS_DIR...
 import argparse
 import json
 import os
@@ -16,7 +18,10 @@ os.environ["OPENCV_IO_ENABLE_OPENEXR"] = "1"
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
+from thinlens import coc_px  # noqa: E402  (this folder: the filter's thin-lens CoC)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
+TOOLS = ["gegl", "blender"]
 
 
 def scene_dirs(path):
@@ -40,51 +45,50 @@ def depth_metres(scene_dir, meta):
     return image.astype(np.float32)
 
 
-def coc_px(depth, lens, width):
-    """Signed thin-lens CoC diameter, pixels, field of view from the focal length (as Cycles and
-    the benchmark's scenes): A f (S2 - S1) / (S2 (S1 - f)) on the sensor, mm, times px per mm."""
-    f = lens["focalLengthMm"]
-    aperture = f / lens["fNumber"]
-    s1 = lens["focusM"] * 1000.0
-    s2 = np.maximum(depth, 1e-3) * 1000.0
-    if lens.get("fieldOfView", "focal-length") != "focal-length":
-        sys.exit("anchors.py: only the focal-length field of view (the renders')")
-    return aperture * f * (s2 - s1) / (s2 * (s1 - f)) * width / lens["sensorWidthMm"]
-
-
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("paths", nargs="+")
     parser.add_argument("--out", default="out/corpus_anchors")
+    parser.add_argument("--tool", action="append", choices=TOOLS,
+                        help="run only this tool (repeatable; default: both)")
     args = parser.parse_args()
+    tools = args.tool or TOOLS
     for path in args.paths:
         for scene_dir in scene_dirs(path):
             name = os.path.basename(os.path.normpath(scene_dir))
             meta = json.load(open(os.path.join(scene_dir, "scene.json")))
+            if meta["lens"].get("fieldOfView") != "focal-length":
+                # Blender's node is calibrated for the renders' camera (blender_defocus.py).
+                sys.exit(f"anchors.py: {scene_dir}/scene.json: lens.fieldOfView must be focal-length "
+                         "(the renders' camera)")
             out = os.path.join(args.out, name)
             os.makedirs(out, exist_ok=True)
             colour = os.path.join(scene_dir, meta["color"])
             width = cv2.imread(colour, cv2.IMREAD_UNCHANGED).shape[1]
-            coc = coc_px(depth_metres(scene_dir, meta), meta["lens"], width)
+            coc = coc_px(np.maximum(depth_metres(scene_dir, meta), 1e-3), meta["lens"], width)
             radius = float(np.ceil(np.abs(coc).max() / 2.0)) + 1.0
 
-            # GEGL: lens-blur's aux mask scales its radius per pixel (linear values 0..1).
-            mask = os.path.join(out, "gegl_mask.exr")
-            cv2.imwrite(mask, (np.abs(coc) / 2.0 / radius).astype(np.float32))
-            start = time.time()
-            target = os.path.join(out, "gegl-lens-blur.exr")
-            subprocess.run(["nice", "-n", "19", "gegl", colour, "-o", target, "--", "gegl:lens-blur",
-                            f"radius={radius}", "linear-mask=true", "clip=true",
-                            "aux=[", "gegl:load", f"path={mask}", "]"], check=True)
-            gegl_s = time.time() - start
+            timings = []
+            if "gegl" in tools:
+                # GEGL: lens-blur's aux mask scales its radius per pixel (linear values 0..1).
+                mask = os.path.join(out, "gegl_mask.exr")
+                cv2.imwrite(mask, (np.abs(coc) / 2.0 / radius).astype(np.float32))
+                start = time.time()
+                target = os.path.join(out, "gegl-lens-blur.exr")
+                subprocess.run(["nice", "-n", "19", "gegl", colour, "-o", target, "--", "gegl:lens-blur",
+                                f"radius={radius}", "linear-mask=true", "clip=true",
+                                "aux=[", "gegl:load", f"path={mask}", "]"], check=True)
+                timings.append(f"gegl {time.time() - start:.1f} s")
 
-            start = time.time()
-            subprocess.run(["nice", "-n", "19", "blender", "-b", "--factory-startup", "--python",
-                            os.path.join(HERE, "blender_defocus.py"), "--", scene_dir,
-                            os.path.join(out, "blender-defocus.exr"), str(radius * 1.2)],
-                           check=True, stdout=subprocess.DEVNULL)
-            print(f"anchors.py: {name}: max CoC radius {radius:.0f} px; gegl {gegl_s:.1f} s, "
-                  f"blender {time.time() - start:.1f} s")
+            if "blender" in tools:
+                start = time.time()
+                subprocess.run(["nice", "-n", "19", "blender", "-b", "--factory-startup", "--python",
+                                os.path.join(HERE, "blender_defocus.py"), "--", scene_dir,
+                                os.path.join(out, "blender-defocus.exr"), str(radius * 1.2)],
+                               check=True, stdout=subprocess.DEVNULL)
+                timings.append(f"blender {time.time() - start:.1f} s")
+            print(f"anchors.py: {name}: max CoC radius {radius:.0f} px; " + ", ".join(timings))
 
 
-main()
+if __name__ == "__main__":
+    main()
