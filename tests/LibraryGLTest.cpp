@@ -1,5 +1,5 @@
 // libdefocus' public API (include/defocus/): its errors speak the command line's words, the
-// command line's automatic focus, the live autofocus, a Filter handed from thread to thread, and
+// command line's automatic focus, the live autofocus, a Filter that follows the calling thread, and
 // what the defocus program takes from it: the contact sheet, the last frame's GPU times, the
 // renderer and the device, and a preset resolved.
 #include <cstdlib>
@@ -163,7 +163,28 @@ TEST_F(Library, FollowGlidesToTheDepthOfTheCentre)
 }
 
 // Defect caught: a Filter that only works on the thread that made it (its context left current
-// there, or not made current on the caller): the second thread's result is wrong or it throws.
+// there, or not made current on the caller): the second thread's frame came back black, without
+// an error, unless the first thread had called release().
+TEST_F(Library, FollowsTheCallingThread)
+{
+    const cv::Mat here = filter_->process(color_, depth_);
+    cv::Mat there;
+    std::string error;
+    std::thread other([&] {
+        try {
+            there = filter_->process(color_, depth_);
+        } catch (const std::exception& e) {
+            error = e.what();
+        }
+    });
+    other.join();
+    ASSERT_EQ(error, "");
+    EXPECT_TRUE(identical(here, there));
+    EXPECT_TRUE(identical(filter_->process(color_, depth_), here)) << "and back on this thread";
+}
+
+// Defect caught: release() that breaks the handover (it is what code written for the older
+// Filter calls before handing it on).
 TEST_F(Library, HandedToAnotherThreadAfterRelease)
 {
     const cv::Mat here = filter_->process(color_, depth_);
@@ -181,7 +202,6 @@ TEST_F(Library, HandedToAnotherThreadAfterRelease)
     other.join();
     ASSERT_EQ(error, "");
     EXPECT_TRUE(identical(here, there));
-    EXPECT_TRUE(identical(filter_->process(color_, depth_), here)) << "and back on this thread";
 }
 
 // Defect caught: contactSheet() that leaves the Filter in another state than a plain frame would
