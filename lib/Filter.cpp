@@ -270,7 +270,11 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     Frame frame;
     switch (color.type()) {
     case CV_8UC3:
-    case CV_32FC3: frame.color = color; break;
+    case CV_32FC3:
+        // A view into a larger image (a cv::Rect of it) has gaps between its rows: the
+        // pipeline uploads whole rows, so it gets a copy.
+        frame.color = color.isContinuous() ? color : color.clone();
+        break;
     case CV_8UC4: cv::cvtColor(color, frame.color, cv::COLOR_BGRA2BGR); break;
     default:
         throw InputError(fmt::format("colour image is {}; expected BGR 8-bit (CV_8UC3, or CV_8UC4 whose fourth "
@@ -282,7 +286,7 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
             // As a 16-bit depth file is read: 0 (no measurement) stays 0.
             depth.convertTo(frame.depth, CV_32F, 1.0 / p.settings.depthScale);
         else if (depth.type() == CV_32FC1)
-            frame.depth = depth;
+            frame.depth = depth; // read row by row: a view of a larger image needs no copy
         else
             throw InputError(fmt::format("depth image is {}; expected 16-bit single-channel (CV_16UC1, {} units per "
                                          "metre) or float metres (CV_32FC1)",

@@ -119,6 +119,32 @@ TEST_F(Library, InputErrorsNameTheImage)
     EXPECT_NO_THROW(filter_->process(color_, half));
 }
 
+// Defect caught: a view into a larger image (rows with gaps between them) refused with a raw
+// OpenCV assertion (isContinuous), or read as if its rows were packed (a sheared frame).
+TEST_F(Library, SubImagesAreFilteredAsTheirCopies)
+{
+    const cv::Rect rect(64, 48, 480, 360); // the frame's aspect ratio, away from every edge
+    const cv::Mat colorView = color_(rect), depthView = depth_(rect);
+    ASSERT_FALSE(colorView.isContinuous());
+    ASSERT_FALSE(depthView.isContinuous());
+    const cv::Mat copied = filter_->process(colorView.clone(), depthView.clone());
+    filter_->reset();
+    cv::Mat viewed;
+    ASSERT_NO_THROW(viewed = filter_->process(colorView, depthView));
+    EXPECT_TRUE(identical(viewed, copied)) << "16-bit depth";
+
+    cv::Mat metres;
+    depth_.convertTo(metres, CV_32F, 1.0 / settings_.depthScale);
+    cv::Mat bgra;
+    cv::cvtColor(color_, bgra, cv::COLOR_BGR2BGRA);
+    filter_->reset();
+    ASSERT_NO_THROW(viewed = filter_->process(colorView, metres(rect)));
+    EXPECT_TRUE(identical(viewed, copied)) << "float depth";
+    filter_->reset();
+    ASSERT_NO_THROW(viewed = filter_->process(bgra(rect), depthView));
+    EXPECT_TRUE(identical(viewed, copied)) << "BGRA colour";
+}
+
 // Defect caught: FirstFrame measuring focus otherwise than `defocus --focus auto` (another
 // window, a mean instead of the median, measured again on later frames): the results differ.
 TEST_F(Library, FirstFrameAutofocusIsTheCommandLinesAuto)

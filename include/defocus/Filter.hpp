@@ -149,7 +149,8 @@ public:
     /// scene-linear. `depth`: along the view axis, CV_16UC1 in Settings::depthScale units per
     /// metre or CV_32FC1 metres; 0, NaN and infinities mean "no measurement" (filled from valid
     /// neighbours); any size with the colour's aspect ratio (resized by nearest neighbour); empty
-    /// = all in focus. `timestampS`: capture time, seconds (AutofocusOptions::Mode::Follow steps by the time
+    /// = all in focus. Either may be a view into a larger image (`image(cv::Rect(...))`; the
+    /// colour is copied then). `timestampS`: capture time, seconds (AutofocusOptions::Mode::Follow steps by the time
     /// between frames; 0 = unknown, taken as 1/30 s). Throws InputError for images it cannot
     /// take and SettingsError when an automatic focus comes out of range.
     cv::Mat process(const cv::Mat& color, const cv::Mat& depth, double timestampS = 0.0);
