@@ -79,21 +79,26 @@ void ensureTexture(gl::Texture& texture, GLenum format, cv::Size size, const cha
 }
 
 /// The range of valid depths in `depth` (any size); `lo`/`hi` unchanged when there is none.
-void validDepthRange(const cv::Mat& depth, float& lo, float& hi)
+/// Returns the share of `depth` that is no measurement (1 when it is empty).
+double validDepthRange(const cv::Mat& depth, float& lo, float& hi)
 {
     float low = std::numeric_limits<float>::max(), high = std::numeric_limits<float>::lowest();
+    std::size_t invalid = 0;
     for (int y = 0; y < depth.rows; ++y) {
         const float* z = depth.ptr<float>(y);
         for (int x = 0; x < depth.cols; ++x)
             if (isValidDepth(z[x])) {
                 low = std::min(low, z[x]);
                 high = std::max(high, z[x]);
+            } else {
+                ++invalid;
             }
     }
     if (low <= high) {
         lo = low;
         hi = high;
     }
+    return depth.empty() ? 1.0 : static_cast<double>(invalid) / static_cast<double>(depth.total());
 }
 
 } // namespace
@@ -151,6 +156,9 @@ struct Pipeline::Impl {
     bool rhombiSecondPending = false; ///< rhombi: pass 2 of this frame has not written A and B
     bool rhombiUsesTiles = false;
     bool depthPrepared = false; ///< the all-in-focus exit skips hole filling until a view needs it
+    /// The frame's share of depth without a measurement, from hole filling or, on the
+    /// all-in-focus exit, from the look at the depth range that decided it.
+    double invalidFraction = 0.0;
     cv::Mat depthInput;
     float fallbackDepth = 1.0f;
     std::size_t frameIndex = 0;
@@ -262,7 +270,7 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     // hole filling, analysis or upload.
     if (quality.adaptive) {
         float lo = p.fallbackDepth, hi = p.fallbackDepth;
-        validDepthRange(frame.depth, lo, hi);
+        p.invalidFraction = validDepthRange(frame.depth, lo, hi);
         const float c0 = cocPixels(p.coefficients, lo), c1 = cocPixels(p.coefficients, hi);
         if (std::max(std::abs(c0), std::abs(c1)) < 0.5f) {
             p.analysis = {};
@@ -291,6 +299,7 @@ void Pipeline::Impl::prepareDepthAndPlan()
         putLightEdgesAtTheirLightsDepth(color, prepared.metres);
     timings.depthPrepMs = msSince(start);
     depthPrepared = true;
+    invalidFraction = prepared.invalidFraction;
 
     start = Clock::now();
     const bool srgbInput = color.type() == CV_8UC3;
@@ -609,7 +618,7 @@ cv::Mat Pipeline::run(const Frame& frame, const LensSettings& lens, const Qualit
     return read(view, encoding);
 }
 
-cv::Mat Pipeline::readTarget(View view) const
+cv::Mat Pipeline::readTarget(View view)
 {
     if (!impl_->rendered)
         impl_->render();
@@ -623,7 +632,7 @@ cv::Mat Pipeline::readTarget(View view) const
     return image;
 }
 
-const cv::Mat& Pipeline::filledDepth() const
+const cv::Mat& Pipeline::filledDepth()
 {
     if (!impl_->depthPrepared)
         impl_->prepareDepthAndPlan();
@@ -632,10 +641,9 @@ const cv::Mat& Pipeline::filledDepth() const
 
 double Pipeline::invalidDepthFraction() const
 {
-    if (!impl_->depthPrepared)
-        impl_->prepareDepthAndPlan();
-    return impl_->prepared.invalidFraction;
+    return impl_->invalidFraction;
 }
+
 
 const FrameTimings& Pipeline::timings() const
 {

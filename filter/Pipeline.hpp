@@ -69,10 +69,15 @@ public:
 
     /// Reads an intermediate target as CV_32FC4 RGBA (rgb linear, a = signed CoC in pixels),
     /// for tests and analysis: one of Input (the CoC pass), Horizontal, DiagonalA, DiagonalB.
-    cv::Mat readTarget(View view) const;
+    /// Renders the passes first where the frame skipped them (all in focus).
+    cv::Mat readTarget(View view);
 
-    /// The last frame's filled depth (CV_32FC1 metres) and the share of it that was holes.
-    const cv::Mat& filledDepth() const;
+    /// The last frame's filled depth (CV_32FC1 metres). Fills the holes first where the frame
+    /// skipped it (all in focus), which replaces the frame's timings, analysis and plan.
+    const cv::Mat& filledDepth();
+    /// The share of the last frame's depth that had no measurement, [0, 1]; recorded during
+    /// process(), so asking runs nothing. At the colour's size; a frame all in focus counts it
+    /// on the depth as given (the same share up to the nearest-neighbour resize).
     double invalidDepthFraction() const;
     /// Timings of the last process() + read().
     const FrameTimings& timings() const;

@@ -164,10 +164,28 @@ struct Filter::Impl {
     /// report from the pipeline's last frame, frame number `index`.
     void fillReport(std::size_t index);
 
-    void bind()
+    /// The context current on the calling thread until the end of the call, whichever thread
+    /// used the Filter before; then what was current there before is again.
+    gl::EglContext::Scope current() const
     {
-        if (!context.isCurrent())
-            context.makeCurrent();
+        try {
+            return gl::EglContext::Scope(context);
+        } catch (const gl::ContextError& error) {
+            throw GlError(fmt::format("defocus::Filter: {} (a Filter is not thread-safe: one call at a time)",
+                                      error.what()));
+        }
+    }
+
+    /// Deletes the pipeline's GL objects with the context current.
+    void dropPipeline() noexcept
+    {
+        try {
+            const auto bound = current();
+            pipeline.reset();
+        } catch (const Error&) {
+            // Another thread is inside a call on this Filter (a caller's bug): the GL objects
+            // go with the context.
+        }
     }
 
     void apply(const Settings& next)
@@ -203,7 +221,10 @@ Filter::Filter(const Settings& settings, const ContextOptions& context)
     if (const auto issues = check(checked); !issues.empty())
         throw SettingsError(issues.front());
     try {
+        // create() makes the context current here: what was current before is put back.
+        const gl::EglContext::Binding before = gl::EglContext::Binding::current();
         impl_ = std::make_unique<Impl>(gl::EglContext::create(toContextOptions(context)));
+        const gl::EglContext::Scope bound(impl_->context, before);
         impl_->pipeline.emplace();
     } catch (const gl::ContextError& error) {
         throw GlError(error.what());
@@ -215,11 +236,8 @@ Filter::Filter(const Settings& settings, const ContextOptions& context)
 
 Filter::~Filter()
 {
-    if (!impl_)
-        return;
-    // The pipeline's GL objects are deleted with the context current on this thread.
-    impl_->bind();
-    impl_->pipeline.reset();
+    if (impl_)
+        impl_->dropPipeline();
 }
 
 Filter::Filter(Filter&&) noexcept = default;
@@ -227,10 +245,8 @@ Filter::Filter(Filter&&) noexcept = default;
 Filter& Filter::operator=(Filter&& other) noexcept
 {
     if (this != &other) {
-        if (impl_) {
-            impl_->bind();
-            impl_->pipeline.reset();
-        }
+        if (impl_)
+            impl_->dropPipeline();
         impl_ = std::move(other.impl_);
     }
     return *this;
@@ -254,7 +270,11 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     Frame frame;
     switch (color.type()) {
     case CV_8UC3:
-    case CV_32FC3: frame.color = color; break;
+    case CV_32FC3:
+        // A view into a larger image (a cv::Rect of it) has gaps between its rows: the
+        // pipeline uploads whole rows, so it gets a copy.
+        frame.color = color.isContinuous() ? color : color.clone();
+        break;
     case CV_8UC4: cv::cvtColor(color, frame.color, cv::COLOR_BGRA2BGR); break;
     default:
         throw InputError(fmt::format("colour image is {}; expected BGR 8-bit (CV_8UC3, or CV_8UC4 whose fourth "
@@ -266,7 +286,7 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
             // As a 16-bit depth file is read: 0 (no measurement) stays 0.
             depth.convertTo(frame.depth, CV_32F, 1.0 / p.settings.depthScale);
         else if (depth.type() == CV_32FC1)
-            frame.depth = depth;
+            frame.depth = depth; // read row by row: a view of a larger image needs no copy
         else
             throw InputError(fmt::format("depth image is {}; expected 16-bit single-channel (CV_16UC1, {} units per "
                                          "metre) or float metres (CV_32FC1)",
@@ -303,7 +323,7 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     }
     p.previousTimestamp = timestampS;
 
-    p.bind();
+    const auto bound = p.current();
     const Encoding encoding =
         p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
     cv::Mat out = p.pipeline->run(frame, lens, p.quality, toView(p.settings.view), encoding);
@@ -350,7 +370,7 @@ const FrameReport& Filter::lastFrame() const
 
 std::vector<Timings::Pass> Filter::finishGpuTimings()
 {
-    impl_->bind();
+    const auto bound = impl_->current();
     std::vector<Timings::Pass> out;
     for (const auto& pass : impl_->pipeline->drainGpuTimes())
         out.push_back({pass.name, pass.ms});
@@ -362,7 +382,7 @@ cv::Mat Filter::contactSheet()
     Impl& p = *impl_;
     if (!p.lastFrame)
         throw InputError("contact sheet: no frame processed yet");
-    p.bind();
+    const auto bound = p.current();
     Pipeline& pipeline = *p.pipeline;
     std::vector<std::pair<std::string, cv::Mat>> tiles;
     int number = 1;
@@ -396,7 +416,10 @@ void Filter::reset()
 
 void Filter::release()
 {
-    impl_->context.release();
+    // Every call puts back what was current on its thread before it, so the context is not
+    // left bound anywhere; this unbinds it only where it still is (it never should be).
+    if (impl_->context.isCurrent())
+        impl_->context.release();
 }
 
 std::string Filter::renderer() const

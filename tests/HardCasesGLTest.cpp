@@ -609,7 +609,7 @@ struct Target {
     cv::Mat coc;
 };
 
-Target readTarget(const Pipeline& pipeline, View view)
+Target readTarget(Pipeline& pipeline, View view)
 {
     std::vector<cv::Mat> rgba;
     cv::split(pipeline.readTarget(view), rgba);

@@ -486,6 +486,26 @@ TEST_F(Passes, AFrameInFocusDoesNotLeaveTheNextFrameUnblurred)
     }
 }
 
+// What a report asks of an all-in-focus frame is known once process() has decided it: asking
+// runs nothing. Defect caught: invalidDepthFraction() filling the holes, uploading and analysing
+// the frame again (the frame's work done twice, its timings replaced by the rerun's).
+TEST_F(Passes, AFrameInFocusReportsWithoutRunningAgain)
+{
+    cv::Mat color(48, 64, CV_8UC3);
+    cv::randu(color, 0, 256);
+    cv::Mat depth(color.size(), CV_32F, cv::Scalar(2.0f));
+    depth(cv::Rect(0, 0, 16, 12)).setTo(0.0f); // a hole: 192 of 3072 pixels
+    LensSettings lens;
+    lens.focusM = 2.0;
+    Pipeline pipeline;
+    pipeline.run({color, depth, 0.0, 0, "sharp"}, lens, QualitySettings{});
+    ASSERT_TRUE(pipeline.plan().allInFocus);
+    EXPECT_DOUBLE_EQ(pipeline.invalidDepthFraction(), 192.0 / 3072.0);
+    EXPECT_EQ(pipeline.timings().depthPrepMs, 0.0) << "no hole filling ran";
+    EXPECT_EQ(pipeline.timings().uploadMs, 0.0) << "nothing went up";
+    EXPECT_TRUE(pipeline.plan().allInFocus);
+}
+
 // The views, on both kernels and every preset: each at the frame's size, and each showing what
 // it names. Three bands of noise: 1 m (near, CoC -18 px), 2 m (the focus), 6 m (far, +12 px).
 // Defect caught: a view that shows the wrong target, the wrong size of texel, a blur stage that

@@ -347,4 +347,37 @@ void EglContext::release() const
     eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
 }
 
+EglContext::Binding EglContext::Binding::current()
+{
+    return {eglGetCurrentDisplay(), eglGetCurrentSurface(EGL_DRAW), eglGetCurrentSurface(EGL_READ),
+            eglGetCurrentContext()};
+}
+
+EglContext::Scope::Scope(const EglContext& context)
+{
+    if (context.isCurrent())
+        return;
+    previous_ = Binding::current();
+    if (eglMakeCurrent(context.state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, context.state_->context) !=
+        EGL_TRUE) {
+        const EGLint error = eglGetError();
+        throw ContextError(error == EGL_BAD_ACCESS
+                               ? std::string("the EGL context is in use on another thread at the same time")
+                               : fmt::format("eglMakeCurrent failed: {}", eglErrorName(error)));
+    }
+    context_ = &context;
+}
+
+EglContext::Scope::Scope(const EglContext& context, const Binding& before) : context_(&context), previous_(before) {}
+
+EglContext::Scope::~Scope()
+{
+    if (!context_)
+        return;
+    if (previous_.context != EGL_NO_CONTEXT)
+        eglMakeCurrent(previous_.display, previous_.draw, previous_.read, previous_.context);
+    else
+        eglMakeCurrent(context_->state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+}
+
 } // namespace defocus::gl

@@ -81,6 +81,36 @@ public:
 
     struct State; ///< display + context, defined in the .cpp
 
+    /// What is current on the calling thread: EGLDisplay, EGLSurfaces and EGLContext, as opaque
+    /// handles (all null: nothing).
+    struct Binding {
+        void* display = nullptr;
+        void* draw = nullptr;
+        void* read = nullptr;
+        void* context = nullptr;
+        static Binding current();
+    };
+
+    /// This context current on the calling thread for the life of the Scope; then what was
+    /// current on the thread before (another context, or none) is current again, so that the
+    /// context is free for any thread between calls and a caller's own context is left as it
+    /// was. A Scope of a context already current on this thread changes nothing. Throws
+    /// ContextError when the context cannot be made current (it is current on another thread).
+    class Scope {
+    public:
+        explicit Scope(const EglContext& context);
+        /// For a context already made current on this thread (create() does): `before` is what
+        /// was current before, put back at the end.
+        Scope(const EglContext& context, const Binding& before);
+        ~Scope();
+        Scope(const Scope&) = delete;
+        Scope& operator=(const Scope&) = delete;
+
+    private:
+        const EglContext* context_ = nullptr; ///< null: the context was current already
+        Binding previous_;
+    };
+
 private:
     explicit EglContext(std::unique_ptr<State> state);
     std::unique_ptr<State> state_;

@@ -4,10 +4,12 @@
 //   defocus::Filter filter(s);                           // throws GlError without GL 4.5
 //   cv::Mat out = filter.process(bgr8, depth16);         // depth16 in s.depthScale units/metre
 //
-// Threads: a Filter is not thread-safe; call it from one thread at a time. Its EGL context is
-// made current on the thread that calls it (construction, process(), the destructor) and stays
-// current there until release(); before another thread uses the Filter, release() it on the
-// thread that used it last. Different Filters are independent and may run on different threads
+// Threads: a Filter is not thread-safe; call it from one thread at a time (any thread, one after
+// another; where a call finds another thread inside one it throws GlError). Each call that renders
+// (construction, process(), contactSheet(), finishGpuTimings(), the destructor) makes the
+// Filter's EGL context current on the calling thread for its duration and then puts back what
+// was current there before (another EGL context of the caller's, or none), so no release() is
+// needed between threads. Different Filters are independent and may run on different threads
 // at once. check(), version(), eglDevices(), probeRenderer() and the structs are plain data and
 // functions that any thread may call (probeRenderer() makes and drops a context of its own).
 // Several clips, one after the other, can share one Filter (one context, one shader build):
@@ -124,9 +126,9 @@ struct FrameReport {
 
 class DEFOCUS_API Filter {
 public:
-    /// Creates the EGL context (made current on this thread) and compiles the shaders: the
-    /// first Filter of a process takes a second or more on llvmpipe. Throws SettingsError for
-    /// settings out of range and GlError where no OpenGL 4.5 context can be made.
+    /// Creates the EGL context and compiles the shaders: the first Filter of a process takes a
+    /// second or more on llvmpipe. Throws SettingsError for settings out of range and GlError
+    /// where no OpenGL 4.5 context can be made.
     explicit Filter(const Settings& settings = {});
     /// The same, on the device that `context` chooses.
     Filter(const Settings& settings, const ContextOptions& context);
@@ -147,7 +149,8 @@ public:
     /// scene-linear. `depth`: along the view axis, CV_16UC1 in Settings::depthScale units per
     /// metre or CV_32FC1 metres; 0, NaN and infinities mean "no measurement" (filled from valid
     /// neighbours); any size with the colour's aspect ratio (resized by nearest neighbour); empty
-    /// = all in focus. `timestampS`: capture time, seconds (AutofocusOptions::Mode::Follow steps by the time
+    /// = all in focus. Either may be a view into a larger image (`image(cv::Rect(...))`; the
+    /// colour is copied then). `timestampS`: capture time, seconds (AutofocusOptions::Mode::Follow steps by the time
     /// between frames; 0 = unknown, taken as 1/30 s). Throws InputError for images it cannot
     /// take and SettingsError when an automatic focus comes out of range.
     cv::Mat process(const cv::Mat& color, const cv::Mat& depth, double timestampS = 0.0);
@@ -168,7 +171,9 @@ public:
     cv::Mat contactSheet();
     /// A new stream: the next frame is frame 0 again, and the autofocus measures afresh.
     void reset();
-    /// Unbinds the EGL context from the calling thread, so that another thread can use the Filter.
+    /// Unbinds the EGL context from the calling thread where it is still bound. Every call
+    /// already unbinds it when it returns, so this is never needed to hand the Filter to
+    /// another thread; it is kept for code written when it was.
     void release();
     /// The OpenGL renderer, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
     std::string renderer() const;
