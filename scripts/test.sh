@@ -10,7 +10,8 @@
 #              library_symbols. About 4 minutes on 2 cores.
 #   --all      every tier; what .ci/run calls. It adds the tests with these labels:
 #                long        the hard-case sweep (HardCasesGLTest) and gst-launch-1.0 pipelines
-#                install     install into a prefix and build tests/consumer against it, twice
+#                install     install into a prefix (programs, scripts, tests/consumer built against
+#                            it, twice) and the .deb of cpack -G DEB
 #                subproject  defocus under another project's add_subdirectory (compiles it again)
 #                timing      the frame-timing comparator (runs alone: it measures)
 #                soak        2,000 frames with memory and GL objects flat
