@@ -3,7 +3,7 @@
 
 #include <iterator>
 
-#include "filter/methods/Presets.hpp"
+#include "filter/Presets.hpp"
 
 namespace defocus {
 

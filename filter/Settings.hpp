@@ -101,7 +101,7 @@ std::string_view kernelName(HexagonKernel kernel); ///< "mcintosh", "rhombi"
 /// Parses a name as printed by kernelName(); returns false when unknown.
 bool parseKernel(std::string_view name, HexagonKernel& kernel);
 
-/// The pipeline's defaults; the programs start from a preset instead (filter/methods/Presets.hpp:
+/// The pipeline's defaults; the programs start from a preset instead (filter/Presets.hpp:
 /// balanced = rhombi, 6 taps, near field, 32F).
 struct QualitySettings {
     /// Taps per directional blur, [2, 64]: per centred segment (McIntosh), per one-sided line

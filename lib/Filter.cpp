@@ -14,12 +14,12 @@
 #include "filter/Autofocus.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Pipeline.hpp"
+#include "filter/Presets.hpp"
 #include "filter/SceneAnalysis.hpp"
 #include "filter/Settings.hpp"
 #include "filter/Views.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
-#include "filter/methods/Presets.hpp"
 
 #ifndef DEFOCUS_VERSION
 #error "DEFOCUS_VERSION is set by CMake from project(VERSION)"

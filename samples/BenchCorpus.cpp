@@ -13,12 +13,13 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/Metrics.hpp"
+#include "bench/methods/Method.hpp"
+#include "bench/methods/Presets.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
-#include "filter/Metrics.hpp"
+#include "filter/Presets.hpp"
 #include "filter/gl/EglContext.hpp"
-#include "filter/methods/Method.hpp"
-#include "filter/methods/Presets.hpp"
 #include "samples/BenchMachine.hpp"
 #include "sources/AccuracyScene.hpp"
 #include "sources/ImageIO.hpp"
@@ -131,7 +132,7 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
     gl::EglContext context = gl::EglContext::create();
     fmt::print("defocus-bench accuracy, {}; {} scene(s); GL renderer {}\ncommand: {}\n", utcNow(), scenes.size(),
                context.info().glRenderer, commandLine);
-    fmt::print("error: linear PSNR clipped to [0,1] against each scene's thin-lens truth; zones (filter/Metrics.hpp): "
+    fmt::print("error: linear PSNR clipped to [0,1] against each scene's thin-lens truth; zones (bench/Metrics.hpp): "
                "lights = within 30 px of an input pixel above white, then depth edges, in focus, near, far\n");
 
     std::map<std::string, std::unique_ptr<Method>> methods;

@@ -13,8 +13,8 @@
 #include <opencv2/core.hpp>
 
 #include "filter/Pipeline.hpp"
+#include "filter/Presets.hpp"
 #include "filter/gl/EglContext.hpp"
-#include "filter/methods/Presets.hpp"
 #include "samples/BenchMachine.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/SyntheticSource.hpp"

@@ -11,7 +11,7 @@ namespace defocus {
 
 struct PlanOptions {
     std::string data = "data/tum_fr1_rpy"; ///< TUM folder
-    std::string preset = "balanced";       ///< quality preset (filter/methods/Presets.hpp)
+    std::string preset = "balanced";       ///< quality preset (filter/Presets.hpp)
     int passes = 3;                        ///< timed passes over each clip, per mode, interleaved
     int syntheticFrames = 12;              ///< frames of each synthetic clip
 };

@@ -14,11 +14,11 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "bench/passes/CalibrationPass.hpp"
 #include "filter/Pipeline.hpp"
+#include "filter/Presets.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/GpuTimer.hpp"
-#include "filter/methods/Presets.hpp"
-#include "filter/passes/CalibrationPass.hpp"
 #include "samples/BenchMachine.hpp"
 #include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
@@ -153,7 +153,7 @@ int runTimingComparison(const TimingOptions& options)
     lens.maxCocPx = options.maxCocPx;
     std::vector<std::string> presetNames = options.presets;
     if (presetNames.empty())
-        for (const Preset& p : presets())
+        for (const QualityPreset& p : qualityPresets())
             presetNames.emplace_back(p.name);
 
     const cv::Size size = frames.front().color.size();

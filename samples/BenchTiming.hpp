@@ -19,7 +19,7 @@ struct TimingOptions {
     std::string data = "data/tum_fr1_rpy"; ///< TUM folder to take frames from
     std::string baseline;                  ///< compare with this file
     std::string writeBaseline;             ///< write the measured ratios here
-    /// The presets timed (filter/methods/Presets.hpp); empty: every preset.
+    /// The presets timed (filter/Presets.hpp); empty: every preset.
     std::vector<std::string> presets;
     int runs = 15;         ///< measured frames per preset (medians over them)
     double maxRatio = 3.0; ///< fail when a preset's frame ratio grows more than this

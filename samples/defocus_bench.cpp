@@ -27,15 +27,15 @@
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
 #include "filter/Pipeline.hpp"
+#include "filter/Presets.hpp"
 #include "filter/Settings.hpp"
 #include "filter/gl/EglContext.hpp"
-#include "sources/FrameSource.hpp"
-#include "filter/methods/Presets.hpp"
 #include "samples/BenchMachine.hpp"
 #include "samples/BenchPlan.hpp"
 #include "samples/BenchTiming.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
+#include "sources/FrameSource.hpp"
 
 #include <unistd.h>
 

@@ -29,19 +29,20 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/Metrics.hpp"
+#include "bench/methods/Method.hpp"
+#include "bench/methods/Presets.hpp"
 #include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
-#include "filter/Metrics.hpp"
+#include "filter/Presets.hpp"
 #include "filter/Views.hpp"
 #include "filter/gl/EglContext.hpp"
-#include "filter/methods/Method.hpp"
-#include "filter/methods/Presets.hpp"
-#include "sources/ImageIO.hpp"
 #include "samples/BenchCorpus.hpp"
 #include "samples/BenchMachine.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
+#include "sources/ImageIO.hpp"
 #include "sources/SyntheticScene.hpp"
 
 namespace {
@@ -586,7 +587,7 @@ int run(const Options& options, const std::string& commandLine)
                lens.fieldOfView == FieldOfView::FocalLength ? "focal length" : "image distance", lens.maxCocPx);
     fmt::print("error: {}; PSNR of linear values clipped to [0,1] (and after sRGB "
                "encoding), SSIM on luma; regions in-focus {:.1f}%, out-of-focus {:.1f}%, depth-edge {:.1f}% "
-               "(filter/Metrics.hpp)\n",
+               "(bench/Metrics.hpp)\n",
                gTruthTitle, 100 * unblurred.regionShare[0], 100 * unblurred.regionShare[1], 100 * unblurred.regionShare[2]);
     fmt::print("time: median of {} runs after {} warm-up runs per setting (the CPU references: 1 run); wall = the "
                "whole frame incl. depth prep, scaling, upload and readback; GPU = GL_TIME_ELAPSED per pass{}\n",
@@ -655,7 +656,7 @@ int run(const Options& options, const std::string& commandLine)
         fmt::print("  {:<58}{:>14}   {}\n", q.what, q.psnr, q.time);
     fmt::print("  (this run measured the unblurred input at {:.2f} dB)\n", unblurred.psnrLinear);
 
-    fmt::print("\nPresets (filter/methods/Presets.cpp):\n");
+    fmt::print("\nPresets (bench/methods/Presets.cpp):\n");
     for (const Preset& p : presets()) {
         const auto match = std::find_if(rows.begin(), rows.end(), [&](const Row& row) {
             return row.info->name == p.method && row.settings.samples == p.settings.samples &&

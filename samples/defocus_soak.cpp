@@ -12,9 +12,9 @@
 #include <unistd.h>
 
 #include "filter/Pipeline.hpp"
+#include "filter/Presets.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Objects.hpp"
-#include "filter/methods/Presets.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
 

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The README's first command on a fresh machine: installs missing Debian packages, builds, renders
+# The README's first command on a fresh machine: installs the Debian packages that building and the
+# demo need when missing (scripts/setup.sh without options: no test-only packages), builds, renders
 # the bundled TUM clip with depth of field (a video + a contact sheet of every view), says where.
 #   scripts/demo.sh
 set -euo pipefail

@@ -1,9 +1,21 @@
 #!/usr/bin/env bash
 # Installs the Debian packages defocus needs, only those that are missing, then configures and
 # builds it. Safe to run again: a second run installs nothing and rebuilds only what changed.
-#   scripts/setup.sh [BUILD_DIR]   (default: build)
+#   scripts/setup.sh [--tests | --all] [BUILD_DIR]   (default: build)
+#     (no option)  what building defocus and scripts/demo.sh need
+#     --tests      and what the default test tier needs (scripts/test.sh): GStreamer's tools and
+#                  plugins for the element's tests, GNU parallel for the batch test
+#     --all        and what every tier needs (scripts/test.sh --all): Slurm and munge for the
+#                  one-node cluster test, and the plugins of the README's GStreamer pipelines.
+#                  The VM, window and container tests install their own (qemu, Xvfb, podman).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+tier=build
+case ${1:-} in
+  --tests) tier=tests; shift ;;
+  --all) tier=all; shift ;;
+  -*) echo "setup.sh: unknown option $1 (use --tests or --all)" >&2; exit 2 ;;
+esac
 build=${1:-"$root/build"}
 
 # Why each package is here: README.md, section "Dependencies".
@@ -18,13 +30,21 @@ packages=(
   libfmt-dev libspdlog-dev # formatting and logging
   nlohmann-json3-dev       # JSON timings and benchmark output
   jq                       # scripts/figures.sh: docs/figures.json
-  libgtest-dev libgmock-dev googletest   # tests
-  libbenchmark-dev         # micro-benchmarks
+  libgtest-dev libgmock-dev googletest   # the test suite, configured with every build
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev   # the GStreamer element (gst/)
-  gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good   # its tests: gst-launch-1.0, pngdec, imagefreeze
-  gstreamer1.0-plugins-ugly gstreamer1.0-libav gstreamer1.0-x   # README pipelines: x264enc, H.264 decoding, ximagesink
-  slurm-wlm munge parallel # many clips: the one-node Slurm test (slurmctld, slurmd, sbatch) and the GNU parallel test
 )
+if [ "$tier" != build ]; then
+  packages+=(
+    gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good   # the element's tests: gst-launch-1.0, pngdec, imagefreeze
+    parallel               # the batch test: defocus --batch under GNU parallel
+  )
+fi
+if [ "$tier" = all ]; then
+  packages+=(
+    slurm-wlm munge        # the one-node Slurm test (slurmctld, slurmd, sbatch)
+    gstreamer1.0-plugins-ugly gstreamer1.0-libav gstreamer1.0-x   # README pipelines: x264enc, H.264 decoding, ximagesink
+  )
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -5,9 +5,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "filter/methods/Method.hpp"
-#include "filter/methods/Presets.hpp"
+#include "bench/methods/Method.hpp"
 #include "filter/Pipeline.hpp"
+#include "filter/Presets.hpp"
 #include "sources/ImageIO.hpp"
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"

@@ -11,7 +11,8 @@
 #include <nlohmann/json.hpp>
 #include <sys/wait.h>
 
-#include "filter/methods/Presets.hpp"
+#include "bench/methods/Presets.hpp"
+#include "filter/Presets.hpp"
 #include "tests/TestSupport.hpp"
 
 namespace defocus {

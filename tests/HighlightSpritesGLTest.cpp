@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/methods/ReferenceScatter.hpp"
 #include "filter/Pipeline.hpp"
-#include "filter/methods/ReferenceScatter.hpp"
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"
 

@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "bench/methods/Method.hpp"
 #include "filter/Lens.hpp"
-#include "filter/methods/Method.hpp"
 #include "filter/passes/HexBlurPass.hpp"
 
 namespace defocus {

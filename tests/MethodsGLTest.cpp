@@ -11,11 +11,12 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/Metrics.hpp"
+#include "bench/methods/Method.hpp"
+#include "bench/methods/Presets.hpp"
+#include "bench/methods/ReferenceScatter.hpp"
 #include "filter/ColorSpace.hpp"
-#include "filter/methods/Method.hpp"
-#include "filter/methods/Presets.hpp"
-#include "filter/methods/ReferenceScatter.hpp"
-#include "filter/Metrics.hpp"
+#include "filter/Presets.hpp"
 #include "sources/ImageIO.hpp"
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"

@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "filter/methods/Method.hpp"
-#include "filter/Metrics.hpp"
+#include "bench/Metrics.hpp"
+#include "bench/methods/Method.hpp"
 #include "tests/TestSupport.hpp"
 
 namespace defocus {

@@ -17,8 +17,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/methods/Method.hpp"
 #include "filter/Lens.hpp"
-#include "filter/methods/Method.hpp"
 #include "sources/ImageIO.hpp"
 #include "sources/SyntheticSource.hpp"
 #include "tests/GLTestSupport.hpp"

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "filter/methods/Presets.hpp"
+#include "filter/Presets.hpp"
 
 namespace defocus::test {
 
@@ -64,9 +64,9 @@ void PrintTo(const NamedQuality& quality, std::ostream* os)
 std::vector<NamedQuality> shippedPresets()
 {
     std::vector<NamedQuality> list{{std::string(kDefaultPreset), presetSettings(kDefaultPreset)}};
-    for (const Preset& p : presets())
+    for (const QualityPreset& p : qualityPresets())
         if (p.name != kDefaultPreset)
-            list.push_back({std::string(p.name), presetSettings(p.name)});
+            list.push_back({std::string(p.name), p.quality});
     return list;
 }
 

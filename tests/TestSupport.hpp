@@ -34,7 +34,7 @@ struct NamedQuality {
 };
 /// GoogleTest prints a parameter by its name.
 void PrintTo(const NamedQuality& quality, std::ostream* os);
-/// The shipped presets (filter/methods/Presets.hpp), the default (balanced) first: what users run.
+/// The shipped presets (filter/Presets.hpp), the default (balanced) first: what users run.
 std::vector<NamedQuality> shippedPresets();
 /// The presets, then each kernel with the pipeline's plain settings (QualitySettings{}: 16 taps,
 /// 16F, full size, no near field): "rhombi" and "mcintosh", the published chain, which no

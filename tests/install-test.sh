@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # Installs defocus into a temporary prefix, builds tests/consumer against it twice (CMake package,
 # then pkg-config) and checks that each consumer's PNG of one bundled frame is the same file, byte
-# for byte, as the command line's with the same settings; and that the GStreamer plugin is installed
-# where GStreamer finds it, loading the installed library.
-#   tests/install-test.sh BUILD_DIR DEFOCUS_CLI [PRESET]
+# for byte, as the command line's with the same settings; that the GStreamer plugin is installed
+# where GStreamer finds it, loading the installed library; and that the programs users run and the
+# batch scripts are installed (bin/, share/defocus/), the test and measuring tools not, and the
+# installed defocus runs on the installed library. Defects caught: a program or script the docs
+# point at that `cmake --install` leaves out, an installed program that finds no libdefocus (no
+# RPATH to the prefix's) or loads the build tree's, a test binary shipped to users.
+#   tests/install-test.sh BUILD_DIR DEFOCUS_CLI [PRESET]        (CTest: install_PRESET, label install)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$1 cli=$2 preset=${3:-balanced}
@@ -11,6 +15,24 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 cmake --install "$build" --prefix "$work/prefix" >/dev/null
+
+# The programs and scripts, and nothing of the tests.
+prefix=$work/prefix
+for program in defocus defocus-preview defocus-synthetic defocus-bench; do
+  [ -x "$prefix/bin/$program" ] || { echo "install-test: $program is not installed in $prefix/bin"; exit 1; }
+  env -u LD_LIBRARY_PATH "$prefix/bin/$program" --help >/dev/null ||
+    { echo "install-test: the installed $program --help fails"; exit 1; }
+done
+for script in defocus.sbatch batch-parallel.sh; do
+  [ -x "$prefix/share/defocus/$script" ] || { echo "install-test: $script is not installed in $prefix/share/defocus"; exit 1; }
+done
+extra=$(find "$prefix/bin" -type f \( -name '*Test' -o -name '*-probe' -o -name 'defocus-soak' -o -name 'v4l2-*' \))
+[ -z "$extra" ] || { echo "install-test: test programs installed: $extra"; exit 1; }
+lib=$(env -u LD_LIBRARY_PATH ldd "$prefix/bin/defocus" | awk '/libdefocus/ {print $3}')
+case "$lib" in "$prefix/"*) ;; *) echo "install-test: the installed defocus loads '$lib', not the installed library"; exit 1 ;; esac
+version=$(env -u LD_LIBRARY_PATH "$prefix/bin/defocus" --version)
+[ "$version" = "$("$cli" --version)" ] || { echo "install-test: the installed defocus --version says '$version'"; exit 1; }
+echo "install-test: $version and the other programs in bin/, the batch scripts in share/defocus/, no test programs"
 # Frame 9 of the bundled clip (the README's picture) and its associated depth.
 read -r _ rgb _ depth < <(sed -n 9p "$root/data/tum_fr1_rpy/associations.txt")
 color=$root/data/tum_fr1_rpy/$rgb depth=$root/data/tum_fr1_rpy/$depth

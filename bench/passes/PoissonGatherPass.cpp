@@ -1,5 +1,5 @@
 // Poisson gather pass: the 12 taps in texture space, the blurriness unit, one draw.
-#include "filter/passes/PoissonGatherPass.hpp"
+#include "bench/passes/PoissonGatherPass.hpp"
 
 #include <algorithm>
 

@@ -1,5 +1,5 @@
 // Pipeline methods: one Pipeline run, read back as linear float, with this frame's GPU times.
-#include "filter/methods/PipelineMethod.hpp"
+#include "bench/methods/PipelineMethod.hpp"
 
 #include <stdexcept>
 

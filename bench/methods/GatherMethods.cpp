@@ -1,6 +1,6 @@
 // The gather methods' shared chain (upload, CoC pass, one pass, readback, GPU timers) and their
 // one-pass bodies.
-#include "filter/methods/GatherMethods.hpp"
+#include "bench/methods/GatherMethods.hpp"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // Gaussian pass: the 25 offsets and normalised weights, one draw.
-#include "filter/passes/GaussianBlurPass.hpp"
+#include "bench/passes/GaussianBlurPass.hpp"
 
 #include <cmath>
 

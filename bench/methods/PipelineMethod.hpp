@@ -5,8 +5,8 @@
 
 #include <string_view>
 
+#include "bench/methods/Method.hpp"
 #include "filter/Pipeline.hpp"
-#include "filter/methods/Method.hpp"
 
 namespace defocus {
 

@@ -1,15 +1,33 @@
-// The presets and the figures they were chosen by.
-#include "filter/methods/Presets.hpp"
+// The quality presets users choose between, as the pipeline's settings, and why each is what it is.
+#include "filter/Presets.hpp"
 
 #include <stdexcept>
 
 #include <fmt/format.h>
 
-#include "filter/methods/PipelineMethod.hpp"
-
 namespace defocus {
 
-const std::vector<Preset>& presets()
+namespace {
+
+/// The rhombi with the foreground spread over what lies behind it, 32-bit float targets, the
+/// per-frame plan and the bokeh sprites on, quarter size off: what the three presets share.
+QualitySettings rhombiNear(int samples, Resolution resolution)
+{
+    QualitySettings q;
+    q.kernel = HexagonKernel::RhombiSum;
+    q.nearField = true;
+    q.samples = samples;
+    q.resolution = resolution;
+    q.targetFormat = TargetFormat::Rgba32F;
+    q.adaptive = true;
+    q.highlightSprites = true;
+    q.quarterOnLargeBlur = false;
+    return q;
+}
+
+} // namespace
+
+const std::vector<QualityPreset>& qualityPresets()
 {
     // Chosen from the Pareto front of `defocus-bench-accuracy --runs 7` (docs/accuracy.md): Blender
     // spheres, 640x480, linear PSNR against the Cycles truth, wall ms per frame (median of 7) on
@@ -37,16 +55,6 @@ const std::vector<Preset>& presets()
     // measures 30.55 dB (tests/AccuracyGLTest, docs/figures.md); the presets all use the rhombi,
     // which keep the hexagon, and a highlight's energy, from preset to preset.
     //
-    // The dB recorded below (and checked by tests/BenchAccuracyGLTest) are the presets' on the
-    // spheres scene after the corpus changes of 2026-11-25 and 26 (docs/accuracy.md, "What each
-    // improvement bought": lights' edges at their light's depth, sprites judged on 3x3 tiles, a
-    // nearer light that does not reach a pixel counted by white's worth, a light in focus in the
-    // blur as what lies round it and put back after it, taps beyond the frame reading its edge
-    // repeated), measured with `defocus-bench-accuracy --scene data/blender_spheres --scene
-    // data/corpus --anchors out/corpus_anchors` (2026-11-26 06:02 UTC): 34.80, 35.11 and 36.28
-    // dB; the table above, the ms and the choice predate them. The edges took 0.24-0.33 dB from
-    // this scene (read mirrored, they measured better here) and raised the corpus.
-    //
     // 32F, not 16F: on llvmpipe the full-float targets ran as fast or faster in nearly every row
     // at the same accuracy (within 0.01 dB), half floats being converted in software on every
     // fetch and store. On a GPU 16F halves the bandwidth and will likely be the faster;
@@ -57,27 +65,21 @@ const std::vector<Preset>& presets()
     // enlarged 3x (`defocus-bench accuracy --scale 3`, docs/benchmarks.md "Quarter size on large
     // blur") it cost 0.38 dB in the median with sprites and 0.43 dB without, more than the 0.1 dB
     // a preset may lose.
-    static const std::vector<Preset> list{
-        {"fast", "rhombi-near", {4, Resolution::Half, TargetFormat::Rgba32F}, 34.80, 20.7},
-        {"balanced", "rhombi-near", {6, Resolution::Half, TargetFormat::Rgba32F}, 35.11, 20.6},
-        {"high", "rhombi-near", {12, Resolution::Full, TargetFormat::Rgba32F}, 36.28, 62.4},
+    static const std::vector<QualityPreset> list{
+        {"fast", rhombiNear(4, Resolution::Half)},
+        {"balanced", rhombiNear(6, Resolution::Half)},
+        {"high", rhombiNear(12, Resolution::Full)},
     };
     return list;
 }
 
-const Preset& preset(std::string_view name)
-{
-    for (const Preset& p : presets())
-        if (p.name == name)
-            return p;
-    throw std::invalid_argument(
-        fmt::format("defocus::preset: no preset called '{}' (choose fast, balanced or high)", name));
-}
-
 QualitySettings presetSettings(std::string_view name)
 {
-    const Preset& p = preset(name);
-    return PipelineMethod::quality(p.method, p.settings);
+    for (const QualityPreset& p : qualityPresets())
+        if (p.name == name)
+            return p.quality;
+    throw std::invalid_argument(
+        fmt::format("defocus::preset: no preset called '{}' (choose fast, balanced or high)", name));
 }
 
 } // namespace defocus

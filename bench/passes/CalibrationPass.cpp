@@ -1,5 +1,5 @@
 // Calibration pass: draws calibration.frag over the whole target.
-#include "filter/passes/CalibrationPass.hpp"
+#include "bench/passes/CalibrationPass.hpp"
 
 #include "filter/passes/Pass.hpp"
 

@@ -1,5 +1,5 @@
 // Exact-coverage aperture-polygon scatter with per-pixel depth layering (see ReferenceScatter.hpp).
-#include "filter/methods/ReferenceScatter.hpp"
+#include "bench/methods/ReferenceScatter.hpp"
 
 #include <algorithm>
 #include <array>

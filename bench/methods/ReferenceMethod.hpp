@@ -2,8 +2,8 @@
 // with the filter's CoC model and input conventions.
 #pragma once
 
-#include "filter/methods/Method.hpp"
-#include "filter/methods/ReferenceScatter.hpp"
+#include "bench/methods/Method.hpp"
+#include "bench/methods/ReferenceScatter.hpp"
 
 namespace defocus {
 

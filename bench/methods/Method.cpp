@@ -1,5 +1,5 @@
 // The method registry, the half-resolution wrapper and the wall clock shared by every method.
-#include "filter/methods/Method.hpp"
+#include "bench/methods/Method.hpp"
 
 #include <cassert>
 #include <chrono>
@@ -8,10 +8,10 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/methods/GatherMethods.hpp"
+#include "bench/methods/PipelineMethod.hpp"
+#include "bench/methods/ReferenceMethod.hpp"
 #include "filter/ColorSpace.hpp"
-#include "filter/methods/GatherMethods.hpp"
-#include "filter/methods/PipelineMethod.hpp"
-#include "filter/methods/ReferenceMethod.hpp"
 #include "filter/passes/CocPass.hpp"
 
 namespace defocus {

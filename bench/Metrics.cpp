@@ -1,5 +1,5 @@
 // PSNR, SSIM and the region split of the error (see Metrics.hpp for the definitions).
-#include "filter/Metrics.hpp"
+#include "bench/Metrics.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -2,14 +2,14 @@
 // read back. Each owns its targets (reallocated only when size or format changes).
 #pragma once
 
+#include "bench/methods/Method.hpp"
+#include "bench/passes/GaussianBlurPass.hpp"
+#include "bench/passes/LazyGatherPass.hpp"
+#include "bench/passes/PoissonGatherPass.hpp"
 #include "filter/Lens.hpp"
 #include "filter/gl/GpuTimer.hpp"
 #include "filter/gl/Objects.hpp"
-#include "filter/methods/Method.hpp"
 #include "filter/passes/CocPass.hpp"
-#include "filter/passes/GaussianBlurPass.hpp"
-#include "filter/passes/LazyGatherPass.hpp"
-#include "filter/passes/PoissonGatherPass.hpp"
 
 namespace defocus {
 

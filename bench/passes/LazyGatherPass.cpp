@@ -1,5 +1,5 @@
 // Lazy gather pass: the eight points in texture space, the threshold, one draw.
-#include "filter/passes/LazyGatherPass.hpp"
+#include "bench/passes/LazyGatherPass.hpp"
 
 #include <algorithm>
 

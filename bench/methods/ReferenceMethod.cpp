@@ -1,13 +1,13 @@
 // Reference method: filled depth -> CoC map -> exact polygon scatter, all on the CPU.
-#include "filter/methods/ReferenceMethod.hpp"
+#include "bench/methods/ReferenceMethod.hpp"
 
 #include <cassert>
 #include <cmath>
 
+#include "bench/Metrics.hpp"
 #include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
-#include "filter/Metrics.hpp"
 #include "filter/passes/CocPass.hpp"
 
 namespace defocus {
