@@ -89,8 +89,11 @@ CLI::Validator positive()
 
 CLI::Validator atLeast(double minimum)
 {
-    return rangeCheck([minimum](double v) { return v >= minimum; }, fmt::format("at least {:g}", minimum),
-                      minimum == 0.0 ? "NONNEGATIVE" : fmt::format(">={:g}", minimum));
+    // The help's words as CLI11's: NONNEGATIVE for 0, POSITIVE for 1 (the whole-number options').
+    const std::string help = minimum == 0.0   ? "NONNEGATIVE"
+                             : minimum == 1.0 ? "POSITIVE"
+                                              : fmt::format(">={:g}", minimum);
+    return rangeCheck([minimum](double v) { return v >= minimum; }, fmt::format("at least {:g}", minimum), help);
 }
 
 CLI::Validator between(double low, double high)

@@ -45,7 +45,7 @@ void printError(std::string_view program, std::string_view message);
 /// the open one as 309 digits). Numbers are compared as doubles; text that is not a number is left
 /// to the option's own conversion error.
 CLI::Validator positive();                        ///< more than 0
-CLI::Validator atLeast(double minimum);           ///< minimum or more
+CLI::Validator atLeast(double minimum);           ///< minimum or more (1: whole numbers, "POSITIVE")
 CLI::Validator between(double low, double high);  ///< low to high, both included
 
 /// The camera options, the same wherever a camera can be opened: --size WxH, --camera-fps and
