@@ -33,7 +33,7 @@ void checkRange(std::vector<SettingIssue>& issues, std::string_view parameter, T
 {
     if (std::isfinite(static_cast<double>(value)) && value >= low && value <= high)
         return;
-    issues.push_back({std::string(parameter), fmt::format("{} {} is outside [{}, {}]", parameter, value, low, high)});
+    issues.push_back({std::string(parameter), fmt::format("{} must be between {} and {}, not {}", parameter, low, high, value)});
     if (clamp)
         value = std::isnan(static_cast<double>(value)) ? low : std::clamp(value, low, high);
 }

@@ -159,7 +159,7 @@ bool parseView(std::string_view name, View& view);
 /// One problem with a setting: which parameter, its value, the allowed range.
 struct SettingIssue {
     std::string parameter; ///< CLI name, e.g. "--f-number"
-    std::string message;   ///< e.g. "--f-number 0.5 is outside [0.7, 64]"
+    std::string message;   ///< e.g. "--f-number must be between 0.7 and 64, not 0.5"
 };
 
 /// Checks every field against its documented range. With `clamp`, out-of-range values are

@@ -40,7 +40,7 @@ void checkRange(std::vector<std::string>& issues, const char* parameter, T& valu
 {
     if (value >= low && value <= high)
         return;
-    issues.push_back(fmt::format("{} {} is outside [{}, {}]", parameter, value, low, high));
+    issues.push_back(fmt::format("{} must be between {} and {}, not {}", parameter, low, high, value));
     if (clamp)
         value = std::isnan(static_cast<double>(value)) ? low : std::clamp(value, low, high);
 }

@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -28,6 +29,19 @@ extern "C" void onStopSignal(int signal)
     gSignal.compare_exchange_strong(none, signal); // the first signal decides the status
 }
 
+/// A range check: `accepts` the number, else the message "must be DESCRIPTION, not VALUE".
+CLI::Validator rangeCheck(std::function<bool(double)> accepts, std::string description, std::string name)
+{
+    return CLI::Validator(
+        [accepts = std::move(accepts), description](std::string& text) -> std::string {
+            double value = 0.0;
+            if (!CLI::detail::lexical_cast(text, value))
+                return {}; // the option's conversion says what is wrong
+            return accepts(value) ? std::string() : fmt::format("must be {}, not {}", description, text);
+        },
+        std::move(name));
+}
+
 } // namespace
 
 std::optional<int> parse(CLI::App& app, int argc, char** argv)
@@ -46,16 +60,46 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv)
         return kExitDone;
     } catch (const CLI::ParseError& error) {
         // A subcommand's own --help, or an error inside it, is reported by the subcommand.
-        printError(program, fmt::format("{} (see --help)", error.what()));
+        printError(program, fmt::format("{} (see --help)", errorMessage(error)));
         return kExitUsage;
     }
     return std::nullopt;
+}
+
+std::string errorMessage(const CLI::ParseError& error)
+{
+    std::string text = error.what();
+    const auto colon = text.find(": must be ");
+    if (dynamic_cast<const CLI::ValidationError*>(&error) && colon != std::string::npos &&
+        text.find(' ') > colon)
+        text.erase(colon, 1);
+    return text;
 }
 
 void printError(std::string_view program, std::string_view message)
 {
     std::fflush(stdout);
     fmt::print(stderr, "{}: error: {}\n", program, message);
+}
+
+CLI::Validator positive()
+{
+    return rangeCheck([](double v) { return v > 0.0; }, "more than 0", "POSITIVE");
+}
+
+CLI::Validator atLeast(double minimum)
+{
+    // The help's words as CLI11's: NONNEGATIVE for 0, POSITIVE for 1 (the whole-number options').
+    const std::string help = minimum == 0.0   ? "NONNEGATIVE"
+                             : minimum == 1.0 ? "POSITIVE"
+                                              : fmt::format(">={:g}", minimum);
+    return rangeCheck([minimum](double v) { return v >= minimum; }, fmt::format("at least {:g}", minimum), help);
+}
+
+CLI::Validator between(double low, double high)
+{
+    return rangeCheck([low, high](double v) { return v >= low && v <= high; },
+                      fmt::format("between {:g} and {:g}", low, high), fmt::format("{:g}..{:g}", low, high));
 }
 
 void logToStderr(std::string_view program, bool quiet, bool verbose)
@@ -82,7 +126,7 @@ void addCameraOptions(CLI::App& app, SourceOptions& source)
            "Camera capture size WIDTHxHEIGHT, pixels; the driver picks the nearest it has")
         ->default_str(fmt::format("{}x{}", source.width, source.height));
     app.add_option("--camera-fps", source.fps, "Camera frame rate to ask for, Hz")
-        ->check(CLI::PositiveNumber)
+        ->check(positive())
         ->capture_default_str();
     app.add_option("--pixel-format", source.pixelFormat,
                    "Camera pixel format, a V4L2 FourCC (YUYV, MJPG, NV12, RGB3, BGR3, GREY) [default: the fastest "
@@ -194,7 +238,7 @@ void addDepthScaleOption(CLI::App& app, std::optional<double>& scale)
 {
     app.add_option("--depth-scale", scale,
                    "Units per metre of 16-bit depth images [default: 5000 for TUM folders, 1000 otherwise]")
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
 }
 
 std::optional<int> checkLensAndQuality(const LensSettings& lens, const QualitySettings& quality, bool autoFocus)

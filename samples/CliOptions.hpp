@@ -33,8 +33,20 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv);
 /// standard output keeps only results. quiet: warnings and errors only; verbose: debug too.
 void logToStderr(std::string_view program, bool quiet = false, bool verbose = false);
 
+/// A parse error's message; a failed range check (positive, atLeast, between) as a sentence,
+/// "--frames must be at least 1, not 0" where CLI11 writes "--frames: must be ...".
+std::string errorMessage(const CLI::ParseError& error);
+
 /// One line on standard error, "PROGRAM: error: MESSAGE", for use before logToStderr.
 void printError(std::string_view program, std::string_view message);
+
+/// Range checks for add_option(...)->check(...) whose error says the range as a user would write
+/// it, "--frames must be at least 1, not 0" (CLI11's own Range prints both ends with six decimals,
+/// the open one as 309 digits). Numbers are compared as doubles; text that is not a number is left
+/// to the option's own conversion error.
+CLI::Validator positive();                        ///< more than 0
+CLI::Validator atLeast(double minimum);           ///< minimum or more (1: whole numbers, "POSITIVE")
+CLI::Validator between(double low, double high);  ///< low to high, both included
 
 /// The camera options, the same wherever a camera can be opened: --size WxH, --camera-fps and
 /// --pixel-format, into `source` (its width, height, fps and pixelFormat).

@@ -7,8 +7,10 @@ namespace defocus {
 
 enum ExitStatus : int {
     kExitDone = 0,         ///< every frame in gave a frame out
-    kExitBadInput = 1,     ///< an input or output file or device that cannot work: do not retry
-    kExitUsage = 2,        ///< the command line (any parse or range error)
+    kExitBadInput = 1,     ///< an input or output file or device that cannot work, or a request the input
+                           ///< cannot meet (one image from several frames): do not retry
+    kExitUsage = 2,        ///< the command line (any parse or range error, options that do not go
+                           ///< together, an --egl-device the machine does not have)
     kExitUnavailable = 75, ///< no EGL display / GL 4.5 context, or a busy device (sysexits' EX_TEMPFAIL): retry
     kExitInterrupted = 130,///< Ctrl-C (128 + SIGINT); what was written is finalised
     kExitTerminated = 143, ///< SIGTERM (128 + SIGTERM), as a scheduler sends at a time limit; finalised

@@ -10,12 +10,16 @@
 // the pipeline's Autofocus) and --demo's synthetic source (which takes the pipeline's lens type). Results go to standard output, diagnostics to standard error;
 // the exit statuses are ExitStatus.hpp's.
 #include <algorithm>
+#include <cctype>
+#include <chrono>
 #include <csignal>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <string>
+#include <system_error>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -76,6 +80,7 @@ struct Options : cli::LensNames, cli::QualityNames {
     std::string demoScene = "spheres";
     bool quiet = false;
     bool verbose = false;
+    double progressInterval = 5.0; ///< --progress-interval, seconds
     bool overwrite = false;   ///< -y: replace outputs that exist
     std::string codec;        ///< --codec, "" = the container's default
     std::string imageFormat = "png"; ///< --image-format of a folder output
@@ -242,6 +247,70 @@ void fillReport(nlohmann::json& r, const Options& options, const Lens& lens, con
     r["timings_ms"] = timingLog.summary();
 }
 
+/// A request the first frame shows the input cannot meet (--focus-point outside it): the clip
+/// ends there, before any frame is written, in one line from the caller (status 1 as bad input).
+class RequestError : public std::invalid_argument {
+public:
+    using std::invalid_argument::invalid_argument;
+};
+
+/// How many frames the clip gives out of `count` input frames after --start, --every and --frames;
+/// with `count` unknown (a camera, a stream), at most --frames, or nullopt without it.
+std::optional<std::size_t> framesOut(const Options& options, std::optional<std::size_t> count)
+{
+    if (!count)
+        return options.frames;
+    const std::size_t taken = *count > options.start ? (*count - options.start + options.every - 1) / options.every : 0;
+    return options.frames ? std::min(taken, *options.frames) : taken;
+}
+
+/// True for an output of one picture (FILE.png, .jpg, .exr): FrameSink.hpp's SingleImageSink.
+bool isOneImage(const std::string& output)
+{
+    std::error_code ec;
+    if (output.empty() || output.back() == '/' || std::filesystem::is_directory(output, ec))
+        return false;
+    std::string ext = std::filesystem::path(output).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".exr";
+}
+
+/// Requests that the clip's length rules out, refused before any frame is rendered (exit status
+/// 1 through cli::statusFor): a one-image output of a clip of several frames (it would keep the
+/// last and drop the others), and a --contact-frame the clip never gives. `count`: the source's
+/// frame count, nullopt when it cannot say.
+void checkAgainstTheClip(const Options& options, std::optional<std::size_t> count)
+{
+    const std::string input = options.demo ? std::string("--demo") : fmt::format("'{}'", options.input);
+    if (isOneImage(options.output)) {
+        const std::optional<std::size_t> out = framesOut(options, count);
+        const std::filesystem::path stem = std::filesystem::path(options.output).replace_extension();
+        const std::string instead = fmt::format("write them to a folder (-o '{}/') or a video (-o '{}.mp4'), or "
+                                                "take one frame with --start N --frames 1",
+                                                stem.string(), stem.string());
+        if (!out)
+            throw SinkError(fmt::format("-o '{}' holds one image but {} gives frames until it ends: {}",
+                                        options.output, input, instead));
+        if (*out > 1)
+            throw SinkError(fmt::format("-o '{}' holds one image but {} gives {} frames: {}", options.output, input,
+                                        *out, instead));
+    }
+    if (options.contactSheet.empty())
+        return;
+    const std::size_t frame = options.contactFrame;
+    if (count && frame >= *count)
+        throw std::invalid_argument(fmt::format("--contact-frame {} is beyond the {} frames of {} (0 to {})", frame,
+                                                *count, input, *count - 1));
+    const bool taken = frame >= options.start && (frame - options.start) % options.every == 0 &&
+                       (!options.frames || (frame - options.start) / options.every < *options.frames);
+    if (!taken)
+        throw std::invalid_argument(fmt::format("--contact-frame {} is not among the frames --start {} --every {}{} "
+                                                "take ({}, {}, ...)",
+                                                frame, options.start, options.every,
+                                                options.frames ? fmt::format(" --frames {}", *options.frames) : "",
+                                                options.start, options.start + options.every));
+}
+
 /// The frames of one clip from `source` through the pipeline into `sink`; returns the exit status.
 /// Stops early at SIGINT/SIGTERM (the sink is finalised all the same) or at an error (the frames
 /// before it are kept).
@@ -251,10 +320,8 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     const Settings::Output output =
         sink.encoding() == SinkEncoding::Linear32F ? Settings::Output::Linear32F : Settings::Output::Srgb8;
 
-    std::optional<std::size_t> total = source.frameCount();
-    if (options.frames)
-        total = total ? std::min(*total, *options.frames) : *options.frames;
-    Progress progress(total, !options.quiet);
+    Progress progress(framesOut(options, source.frameCount()), !options.quiet,
+                      std::chrono::duration<double>(options.progressInterval));
 
     Settings settings = options.settings;
     settings.output = output;
@@ -293,6 +360,11 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
             if (position < options.start || (position - options.start) % options.every != 0)
                 continue; // --start, --every
             ++framesIn;
+            if (point && framesIn == 1 &&
+                !(point->x < frame->color.cols && point->y < frame->color.rows)) // parsePoint: not negative
+                throw RequestError(fmt::format("--focus-point {} is outside the {}x{} frame (X 0 to {}, Y 0 to {})",
+                                               options.focusPoint, frame->color.cols, frame->color.rows,
+                                               frame->color.cols - 1, frame->color.rows - 1));
             if (!depthChecked && !demo && options.depthScaleUsed > 0.0) {
                 const DepthScaleCheck check = checkDepthScale(frame->depth, options.depthScaleUsed, frame->name);
                 depthChecked = check.validPixels > 0;
@@ -343,6 +415,9 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
             ++timed;
             progress.update(framesIn);
         }
+    } catch (const RequestError&) {
+        progress.finish();
+        throw;
     } catch (const std::exception& error) {
         progress.finish();
         // A write that failed on the writing thread is rethrown frames later: name its frame.
@@ -367,9 +442,12 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         passMs[pass.name] += pass.ms;
     if (!options.timings.empty() && framesIn > 0)
         timingLog.write(options.timings, filter.renderer(), frameSize);
-    if (!options.contactSheet.empty() && !sheetWritten && status == kExitDone && !cli::stopRequested())
-        spdlog::warn("--contact-frame {} is beyond the {} frames read: no contact sheet written to {}",
-                     options.contactFrame, framesIn, options.contactSheet);
+    // checkAgainstTheClip refused it up front where the clip's length was known.
+    if (!options.contactSheet.empty() && !sheetWritten && status == kExitDone && !cli::stopRequested()) {
+        spdlog::error("--contact-frame {} is beyond the {} frames read: no contact sheet written to {}",
+                      options.contactFrame, read, options.contactSheet);
+        status = kExitBadInput;
+    }
     if (cli::stopRequested()) {
         spdlog::warn("stopped by {} after {} frames; {} is finalised", cli::stopSignal() == SIGINT ? "Ctrl-C" : "SIGTERM",
                      framesIn, options.output);
@@ -420,6 +498,14 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
         source = openSource(sourceOptions);
         options.depthScaleUsed = options.depthScale.value_or(defaultDepthScale(sourceOptions));
     }
+    // The outputs' folders after the input (whose errors come first), before GL (openSink checks
+    // the main output's again).
+    std::error_code ec;
+    requireParentFolder(options.output, options.output.back() == '/' || std::filesystem::is_directory(options.output, ec));
+    for (const std::string* file : {&options.contactSheet, &options.timings})
+        if (!file->empty())
+            requireParentFolder(*file, false);
+    checkAgainstTheClip(options, source->frameCount());
 
     if (!filter)
         filter.emplace(Settings{}, contextOptions(options));
@@ -484,18 +570,18 @@ void declareOptions(CLI::App& app, Options& o)
         ->capture_default_str();
     app.add_option("--contact-sheet", o.contactSheet, "Also write every view of one frame, labelled, to this PNG");
     app.add_option("--contact-frame", o.contactFrame, "Frame index for --contact-sheet")->capture_default_str();
-    app.add_option("--frames", o.frames, "Stop after this many frames out")->check(CLI::PositiveNumber);
+    app.add_option("--frames", o.frames, "Stop after this many frames out")->check(cli::atLeast(1));
     app.add_option("--start", o.start, "Skip this many input frames first")->capture_default_str();
     app.add_option("--every", o.every, "Then take every Nth input frame (2 = every other)")
-        ->check(CLI::PositiveNumber)
+        ->check(cli::atLeast(1))
         ->capture_default_str();
     app.add_option("--focus-point", o.focusPoint,
                    "X,Y: measure the focus at this pixel (the median of the valid depths in a window around it) "
                    "instead of the centre; with --focus auto or track");
     app.add_option("--tau", o.autofocus.timeConstantS, "--focus track: time constant, seconds (critically damped), >= 0")
-        ->check(CLI::NonNegativeNumber)
+        ->check(cli::atLeast(0))
         ->capture_default_str();
-    app.add_option("--fps", o.fps, "Frame rate of a video output, Hz [default: the input's]")->check(CLI::PositiveNumber);
+    app.add_option("--fps", o.fps, "Frame rate of a video output, Hz [default: the input's]")->check(cli::positive());
     app.add_option("--timings", o.timings, "Write per-frame, per-pass timings with a p50/p95/max summary to this JSON file");
     app.add_flag("--explain", o.explain, "Print per frame which passes ran and on how many tiles");
     app.add_flag("--always-on", o.settings.quality.alwaysOn, "Run every pass on every pixel, ignoring the per-frame plan (for comparisons)");
@@ -508,6 +594,11 @@ void declareOptions(CLI::App& app, Options& o)
         ->capture_default_str();
     app.add_flag("-q,--quiet", o.quiet, "Only the summary line and errors");
     app.add_flag("-v,--verbose", o.verbose, "Debug logging");
+    app.add_option("--progress-interval", o.progressInterval,
+                   "Seconds between progress lines (frames, fps, time left) when standard error is not a terminal "
+                   "(a log file, Slurm, CI; 0 = every frame); a terminal gets a bar redrawn in place")
+        ->check(cli::atLeast(0))
+        ->capture_default_str();
 
     cli::addCameraOptions(app, o.camera);
     app.add_flag("-y,--overwrite", o.overwrite,
@@ -524,7 +615,7 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_option("--egl-device", o.eglDevice,
                    "EGL device to render on, only that one (--info lists them) [default: the GPU that "
                    "CUDA_VISIBLE_DEVICES makes CUDA's first, else the first that works, else Mesa surfaceless]")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::atLeast(0));
     app.add_option("--report", o.report,
                    "When the clip is done (or failed on its input), write a JSON report: frames, settings, timings, "
                    "renderer, version, commit, exit status");
@@ -536,7 +627,7 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_flag("--redo", o.redo, "--batch: do clips that have a report again");
     app.add_option("--report-dir", o.reportDir, "--batch: put the reports here [default: beside each output]");
     app.add_option("--in-flight", o.inFlight, "--batch: clips processed at once, a GL context each, 1..16")
-        ->check(CLI::Range(1, 16))
+        ->check(cli::between(1, 16))
         ->capture_default_str();
 }
 
@@ -599,10 +690,54 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
     return issues.empty() ? std::nullopt : std::optional<int>(kExitUsage);
 }
 
+/// Options that --batch takes from its manifest, or that only --batch reads: refused where they
+/// would be ignored. nullopt: go on; otherwise kExitUsage, with the reason logged.
+std::optional<int> checkBatchOptions(const CLI::App& app, const Options& o)
+{
+    if (!o.batch.empty()) {
+        const char* refused = !o.input.empty()      ? "INPUT"
+                              : app.count("-o") > 0 ? "-o"
+                              : app.count("--report") > 0 ? "--report"
+                                                          : nullptr;
+        if (!refused)
+            return std::nullopt;
+        spdlog::error("{} does not go with --batch: the manifest names each clip's input and output, and each clip's "
+                      "report is OUTPUT.report.json (or in --report-dir)",
+                      refused);
+        return kExitUsage;
+    }
+    for (const char* name : {"--shard", "--redo", "--report-dir", "--in-flight"})
+        if (app.count(name) > 0) {
+            spdlog::error("{} is an option of --batch MANIFEST, which is not given", name);
+            return kExitUsage;
+        }
+    return std::nullopt;
+}
+
+/// --egl-device N on a machine with fewer devices: a job that can never run here, so the command
+/// line's status (2), not no-GL's retry (75). With no EGL device at all, the context's own error
+/// (75) says why.
+std::optional<int> checkEglDevice(const Options& o)
+{
+    if (!o.eglDevice)
+        return std::nullopt;
+    const std::vector<EglDevice> devices = eglDevices();
+    if (devices.empty() ||
+        std::any_of(devices.begin(), devices.end(), [&](const EglDevice& d) { return d.index == *o.eglDevice; }))
+        return std::nullopt;
+    std::vector<std::string> names;
+    for (const EglDevice& d : devices)
+        names.push_back(fmt::format("{} ({})", d.index, d.software ? "software" : "hardware"));
+    spdlog::error("--egl-device {} does not exist here: this machine's EGL devices are {} (--info lists them)",
+                  *o.eglDevice, fmt::join(names, ", "));
+    return kExitUsage;
+}
+
 /// One clip with --report: the report is written after the clip, when it is done or failed on
 /// its input; a stopped clip or a GL failure leaves none (as --batch does).
 int runReported(const Options& options, std::optional<Filter>& filter)
 {
+    requireParentFolder(options.report, false); // before the clip, which would be lost for it
     nlohmann::json report = nlohmann::json::object();
     int status = kExitDone;
     try {
@@ -659,7 +794,7 @@ int runBatchCommand(const Options& global, const std::vector<std::string>& argum
         try {
             app.parse(args);
         } catch (const CLI::ParseError& error) {
-            spdlog::error("{}:{}: {}", global.batch, clip.line, error.what());
+            spdlog::error("{}:{}: {}", global.batch, clip.line, cli::errorMessage(error));
             return kExitUsage;
         }
         o.quiet = true;     // per-clip result lines only; no progress bars
@@ -721,6 +856,10 @@ int main(int argc, char** argv)
     cli::logToStderr("defocus", o.quiet, o.verbose);
 
     try {
+        if (const auto status = checkBatchOptions(app, o))
+            return *status;
+        if (const auto status = checkEglDevice(o))
+            return *status;
         if (o.info)
             return printInfo(o);
         if (!o.batch.empty()) {

@@ -572,16 +572,16 @@ CLI::App* declareTiming(CLI::App& app, defocus::TimingOptions& o)
     sub->add_option("--quality", o.presets, "Presets timed, comma-separated: fast, balanced, high [default: all]")
         ->delimiter(',')
         ->check(CLI::IsMember({"fast", "balanced", "high"}));
-    sub->add_option("--runs", o.runs, "Measured frames per preset")->capture_default_str()->check(CLI::Range(3, 10000));
+    sub->add_option("--runs", o.runs, "Measured frames per preset")->capture_default_str()->check(cli::between(3, 10000));
     sub->add_option("--max-ratio", o.maxRatio, "Largest allowed growth of a preset's frame ratio over the baseline's")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(cli::positive());
     sub->add_option("--f-number", o.fNumber, "Lens of the timed frames (50 mm focused at 1 m): f-number")
         ->capture_default_str()
-        ->check(CLI::Range(0.7, 64.0));
+        ->check(cli::between(0.7, 64.0));
     sub->add_option("--max-coc", o.maxCocPx, "Largest blur diameter, pixels")
         ->capture_default_str()
-        ->check(CLI::Range(0.0, 512.0));
+        ->check(cli::between(0.0, 512.0));
     return sub;
 }
 
@@ -597,10 +597,10 @@ CLI::App* declarePlan(CLI::App& app, defocus::PlanOptions& o)
         ->capture_default_str();
     sub->add_option("--passes", o.passes, "Timed passes over each clip per mode")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000));
+        ->check(cli::between(1, 1000));
     sub->add_option("--synthetic-frames", o.syntheticFrames, "Frames of each synthetic clip")
         ->capture_default_str()
-        ->check(CLI::Range(1, 10000));
+        ->check(cli::between(1, 10000));
     return sub;
 }
 
@@ -646,10 +646,10 @@ int main(int argc, char** argv)
         ->delimiter(',')
         ->capture_default_str();
     app.add_option("--runs", o.runs, "Measured frames per size and scene")
-        ->check(CLI::Range(1, 100000))
+        ->check(cli::between(1, 100000))
         ->capture_default_str();
     app.add_option("--warmup", o.warmup, "Unmeasured frames first, per size and scene")
-        ->check(CLI::Range(0, 1000))
+        ->check(cli::between(0, 1000))
         ->capture_default_str();
     cli::addQualityOptions(app, o.quality, o);
     app.add_flag("--quarter-on-large-blur", o.quarterOnLargeBlur,

@@ -786,17 +786,17 @@ int main(int argc, char** argv)
     app.add_option("-o,--output", options.out, "output folder for CSV, JSON, pareto.png, contact_sheet.png")
         ->capture_default_str();
     app.add_option("--runs", options.runs, "timed runs per setting (median reported)")
-        ->check(CLI::Range(5, 1000))
+        ->check(cli::between(5, 1000))
         ->capture_default_str();
     app.add_option("--warmup", options.warmup, "unmeasured runs before them")
-        ->check(CLI::Range(0, 100))
+        ->check(cli::between(0, 100))
         ->capture_default_str();
     app.add_option("--methods", methods, "comma-separated subset of: mcintosh,mcintosh-near,rhombi,rhombi-near,riguer,"
                                          "lazy8,gaussian5x5,reference,reference-pointy (default: all)");
     app.add_flag("--no-reference", options.noReference, "skip the CPU references (seconds each)");
     app.add_option("--blade-rotation", options.bladeRotationDeg,
                    "hexagon of the GPU methods, degrees (0 = a corner on top, as the truths; 30 = flat top)")
-        ->check(CLI::Range(-180.0, 180.0))
+        ->check(cli::between(-180.0, 180.0))
         ->capture_default_str();
     app.add_flag("--no-timers", options.noTimers, "no GL timer queries");
     app.add_flag("--no-highlight-sprites", options.noHighlightSprites,
@@ -825,7 +825,7 @@ int main(int argc, char** argv)
     app.add_option("--scale", corpus.scale,
                    "scene folders only: enlarge every scene by this factor (colour and truth bilinear, depth "
                    "nearest, lens unchanged: the CoC in pixels grows with it), to judge large frames' blur")
-        ->check(CLI::Range(1, 8))
+        ->check(cli::between(1, 8))
         ->capture_default_str();
     app.add_flag("--missing-ok", corpus.missingOk,
                  "scene folders only: exit 77 (skipped) when a --scene folder does not exist");

@@ -335,7 +335,7 @@ int main(int argc, char** argv)
     app.add_option("--depth", o.depth, "Depth for INPUT: one image (fixed camera), a folder, depth.txt, or /dev/videoN");
     cli::addDepthScaleOption(app, o.depthScale);
     cli::addCameraOptions(app, o.camera);
-    app.add_option("--frames", o.frames, "Stop reading after this many frames")->check(CLI::PositiveNumber);
+    app.add_option("--frames", o.frames, "Stop reading after this many frames")->check(cli::atLeast(1));
     app.add_option("--focus", o.focus,
                    "'auto' (autofocus on; click to focus) or a distance in metres / 'inf' (autofocus off)")
         ->capture_default_str();
@@ -348,14 +348,14 @@ int main(int argc, char** argv)
         ->check(CLI::IsMember(views))
         ->capture_default_str();
     app.add_option("--tau", o.autofocus.timeConstantS, "Autofocus time constant, seconds (critically damped), >= 0")
-        ->check(CLI::NonNegativeNumber)
+        ->check(cli::atLeast(0))
         ->capture_default_str();
     app.add_option("--af-window", o.autofocus.windowFraction, "Autofocus centre window, fraction of each axis, (0, 1]")
-        ->check(CLI::Range(1e-3, 1.0))
+        ->check(cli::between(1e-3, 1.0))
         ->capture_default_str();
     app.add_option("--af-dead-band", o.autofocus.deadBandDioptres,
                    "Autofocus dead band, dioptres: smaller changes of the measured depth are ignored")
-        ->check(CLI::NonNegativeNumber)
+        ->check(cli::atLeast(0))
         ->capture_default_str();
     app.add_flag("--loop", o.loop, "Play a recorded clip again and again");
     app.add_flag("--exit-at-end", o.exitAtEnd, "Quit at the end of a clip (or after --frames) instead of holding");

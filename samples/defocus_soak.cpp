@@ -55,8 +55,8 @@ int main(int argc, char** argv)
     std::string qualityName(kDefaultPreset);
     CLI::App app{"defocus-soak: frames through the pipeline with flat memory and GL object counts"};
     app.add_option("--frames", frames, "Frames to run")->capture_default_str();
-    app.add_option("--width", width, "Frame width, pixels")->capture_default_str()->check(CLI::Range(2, 8192));
-    app.add_option("--height", height, "Frame height, pixels")->capture_default_str()->check(CLI::Range(2, 8192));
+    app.add_option("--width", width, "Frame width, pixels")->capture_default_str()->check(cli::between(2, 8192));
+    app.add_option("--height", height, "Frame height, pixels")->capture_default_str()->check(cli::between(2, 8192));
     app.add_option("--max-growth-mb", maxGrowthMiB, "Allowed RSS growth after warm-up, MiB")->capture_default_str();
     app.add_option("--quality", qualityName, "Preset the frames run with, as defocus --quality")
         ->capture_default_str()

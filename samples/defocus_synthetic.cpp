@@ -7,15 +7,19 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
 
 #include "filter/ColorSpace.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
+#include "sinks/FrameSink.hpp"
+#include "sinks/ImageSinks.hpp"
 #include "sources/SyntheticScene.hpp"
 
 namespace {
@@ -23,12 +27,15 @@ namespace {
 using namespace defocus;
 namespace fs = std::filesystem;
 
-/// Exit codes: 0 done, 1 runtime failure (GL, output), 2 bad command line.
+/// Exit statuses as defocus's (ExitStatus.hpp): 0 done, 1 output, 2 command line, 75 no GL.
 
-void write(const fs::path& file, const cv::Mat& image)
+/// The files written into the output folder; the reference's only with it.
+std::vector<std::string> outputFiles(bool reference)
 {
-    if (!cv::imwrite(file.string(), image))
-        throw std::runtime_error(fmt::format("cannot write {}", file.string()));
+    std::vector<std::string> files{"color.exr", "color.png", "depth.exr"};
+    if (reference)
+        files.insert(files.end(), {"reference.exr", "reference.png"});
+    return files;
 }
 
 } // namespace
@@ -68,8 +75,10 @@ int main(int argc, char** argv)
     app.add_option("--blade-rotation", settings.lens.bladeRotationDeg,
                    "Degrees counter-clockwise in the image; 0 = a corner straight up")
         ->capture_default_str();
-    app.add_option("--runs", runs, "Render the reference this many times and print each time")->check(CLI::Range(1, 100));
+    app.add_option("--runs", runs, "Render the reference this many times and print each time")->check(cli::between(1, 100));
     app.add_flag("--no-reference", noReference, "Only the pinhole colour and the depth");
+    bool overwrite = false;
+    app.add_flag("-y,--overwrite", overwrite, "Replace output files that exist (without it, an existing one is refused)");
     if (const auto status = cli::parse(app, argc, argv))
         return *status;
     cli::logToStderr("defocus-synthetic");
@@ -79,22 +88,26 @@ int main(int argc, char** argv)
         try {
             settings.lens.focusM = std::stod(focus);
         } catch (const std::exception&) {
-            fmt::print(stderr, "defocus-synthetic: --focus '{}' is neither metres nor 'pull'\n", focus);
+            spdlog::error("--focus '{}' is neither metres nor 'pull'", focus);
             return kExitUsage;
         }
         settings.focusPull = false;
     }
     if (const auto issues = validate(settings); !issues.empty()) {
         for (const auto& issue : issues)
-            fmt::print(stderr, "defocus-synthetic: {}\n", issue);
+            spdlog::error("{}", issue);
         return kExitUsage;
     }
     if (frame >= settings.frames) {
-        fmt::print(stderr, "defocus-synthetic: --frame {} is not below --frames {}\n", frame, settings.frames);
+        spdlog::error("--frame {} is not below --frames {}", frame, settings.frames);
         return kExitUsage;
     }
     ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0); // before OpenCV's first EXR write; a user's value wins
     try {
+        // The output, as defocus's: its folder's parent exists, and no file is replaced without -y.
+        requireParentFolder(fs::path(out) / "", true);
+        for (const std::string& file : outputFiles(!noReference))
+            refuseExisting(fs::path(out) / file, overwrite);
         auto context = gl::EglContext::create();
         SyntheticScene scene(syntheticScene(sceneName), settings);
         fmt::print("{} on {}: {} triangles, {}x{}\n", sceneName, context.info().glRenderer, scene.triangleCount(),
@@ -116,19 +129,19 @@ int main(int argc, char** argv)
         fmt::print("frame {}: {} mm f/{:g} focus {:.3f} m, sensor {} mm, {} blades at {:g} deg\n", frame,
                    lens.focalLengthMm, lens.fNumber, lens.focusM, lens.sensorWidthMm, settings.aperture.blades,
                    lens.bladeRotationDeg);
-        fs::create_directories(out);
-        write(fs::path(out) / "color.exr", images.frame.color);
-        write(fs::path(out) / "color.png", encodeSrgb(images.frame.color));
-        write(fs::path(out) / "depth.exr", images.frame.depth);
+        fs::create_directory(out);
+        writeImageAtomically(fs::path(out) / "color.exr", images.frame.color);
+        writeImageAtomically(fs::path(out) / "color.png", encodeSrgb(images.frame.color));
+        writeImageAtomically(fs::path(out) / "depth.exr", images.frame.depth);
         if (!images.reference.empty()) {
-            write(fs::path(out) / "reference.exr", images.reference);
-            write(fs::path(out) / "reference.png", encodeSrgb(images.reference));
+            writeImageAtomically(fs::path(out) / "reference.exr", images.reference);
+            writeImageAtomically(fs::path(out) / "reference.png", encodeSrgb(images.reference));
         }
         fmt::print("wrote {}/color.exr, depth.exr{} (+ PNG previews)\n", out,
                    images.reference.empty() ? "" : ", reference.exr");
         return kExitDone;
     } catch (const std::exception& error) {
-        fmt::print(stderr, "defocus-synthetic: error: {}\n", error.what());
+        spdlog::error("{}", error.what());
         return cli::statusFor(error);
     }
 }

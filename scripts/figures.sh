@@ -29,7 +29,7 @@ sections=(
   "plan|the per-frame plan against every pass on every pixel (README Speed)|$build/defocus-bench plan"
   "timing|each preset's frame time over the calibration pass (tests/timing_baseline.json)|$build/defocus-bench timing --runs 15"
   "accuracy|the accuracy sweep on the Blender scene (docs/accuracy.md, README Accuracy)|$build/defocus-bench-accuracy --runs 7 -o $out/accuracy"
-  "synthetic|one frame of the synthetic thin-lens truth (README Synthetic truth)|$build/defocus-synthetic --scene spheres --focal-length 85 --f-number 1.4 --focus 5 -o $out/synthetic"
+  "synthetic|one frame of the synthetic thin-lens truth (README Synthetic truth)|$build/defocus-synthetic --scene spheres --focal-length 85 --f-number 1.4 --focus 5 -y -o $out/synthetic"
   "soak|10,000 frames: memory and GL objects (README Stability)|$build/defocus-soak --frames 10000"
 )
 

@@ -7,6 +7,8 @@
 #include <limits>
 #include <system_error>
 
+#include <dlfcn.h>
+
 #include <fmt/format.h>
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -233,6 +235,34 @@ cv::Mat composeHud(const cv::Mat& frame, const HudStatus& status, const SceneAna
     return out;
 }
 
+namespace {
+
+/// Whether an X server answers at DISPLAY, asked as Qt's xcb platform asks (xcb_connect, from the
+/// libxcb that Qt loads; looked up at run time, so the build needs no X headers). True where
+/// libxcb is missing: the window's own error says why then.
+bool xServerAnswers()
+{
+    void* xcb = ::dlopen("libxcb.so.1", RTLD_NOW | RTLD_LOCAL);
+    if (!xcb)
+        return true;
+    using Connect = void* (*)(const char*, int*);
+    using HasError = int (*)(void*);
+    using Disconnect = void (*)(void*);
+    const auto connect = reinterpret_cast<Connect>(::dlsym(xcb, "xcb_connect"));
+    const auto hasError = reinterpret_cast<HasError>(::dlsym(xcb, "xcb_connection_has_error"));
+    const auto disconnect = reinterpret_cast<Disconnect>(::dlsym(xcb, "xcb_disconnect"));
+    bool answers = true;
+    if (connect && hasError && disconnect) {
+        void* connection = connect(nullptr, nullptr); // never null: a connection in an error state
+        answers = hasError(connection) == 0;
+        disconnect(connection);
+    }
+    ::dlclose(xcb);
+    return answers;
+}
+
+} // namespace
+
 DisplaySink::DisplaySink(LiveControls& controls, DisplayOptions options)
     : controls_(controls), options_(std::move(options))
 {
@@ -244,6 +274,10 @@ DisplaySink::DisplaySink(LiveControls& controls, DisplayOptions options)
     if (!set("DISPLAY") && !set("WAYLAND_DISPLAY") && !set("QT_QPA_PLATFORM"))
         throw SinkError("DisplaySink: no display to open a window on (DISPLAY is not set); run under X11, "
                         "Wayland or Xvfb, or use --no-window");
+    if (set("DISPLAY") && !set("QT_QPA_PLATFORM") && !xServerAnswers())
+        throw SinkError(fmt::format("DisplaySink: no X server answers at DISPLAY={} (a stale DISPLAY?); start "
+                                    "one or Xvfb there, or use --no-window",
+                                    std::getenv("DISPLAY")));
     try {
         cv::namedWindow(options_.title, cv::WINDOW_AUTOSIZE | cv::WINDOW_KEEPRATIO | cv::WINDOW_GUI_NORMAL);
         cv::setMouseCallback(options_.title, &DisplaySink::onMouse, this);

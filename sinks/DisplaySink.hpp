@@ -58,7 +58,7 @@ inline constexpr const char* kKeyHelp =
 struct KeyOutcome {
     bool handled = false;
     std::string message;          ///< e.g. "f/2.8"; empty for keys with nothing to say
-    std::vector<SettingIssue> issues; ///< clamps, e.g. "--f-number 71.8 is outside [0.7, 64]"
+    std::vector<SettingIssue> issues; ///< clamps, e.g. "--f-number must be between 0.7 and 64, not 71.8"
 };
 
 /// Applies one key as cv::waitKey() returns it (ASCII; 27 = Esc). The f-number moves by 1/3
@@ -110,8 +110,8 @@ struct DisplayOptions {
 };
 
 /// The window. Needs a display: DISPLAY (X11, Xvfb) or WAYLAND_DISPLAY, or QT_QPA_PLATFORM for
-/// Qt builds of highgui; without one the constructor throws SinkError (highgui's Qt backend
-/// would otherwise abort the process).
+/// Qt builds of highgui; without one, or with a DISPLAY where no X server answers, the
+/// constructor throws SinkError (highgui's Qt backend would otherwise abort the process).
 class DisplaySink final : public FrameSink {
 public:
     DisplaySink(LiveControls& controls, DisplayOptions options = {});

@@ -33,6 +33,18 @@ void refuseExisting(const fs::path& file, bool overwrite)
     throw SinkError(fmt::format("output '{}' exists (-y overwrites it)", file.string()));
 }
 
+void requireParentFolder(const fs::path& output, bool isFolder)
+{
+    fs::path path = output;
+    if (isFolder && !path.has_filename())
+        path = path.parent_path(); // out/frames/ -> out/frames
+    const fs::path parent = path.parent_path();
+    std::error_code ec;
+    if (parent.empty() || fs::is_directory(parent, ec))
+        return;
+    throw SinkError(fmt::format("cannot write '{}': folder '{}' does not exist", output.string(), parent.string()));
+}
+
 void writeFileAtomically(const fs::path& file, const std::string& contents)
 {
     const fs::path partial =
@@ -64,9 +76,11 @@ std::unique_ptr<FrameSink> openSink(const SinkOptions& options)
         return std::make_unique<V4l2OutputSink>(output, options.fps);
     std::error_code ec;
     if (text.back() == '/' || fs::is_directory(output, ec)) {
+        requireParentFolder(output, true);
         refuseExisting(output, options.overwrite);
         return std::make_unique<ImageSequenceSink>(output, options.linearSequence, options.fps);
     }
+    requireParentFolder(output, false);
     refuseExisting(output, options.overwrite);
 
     std::string ext = output.extension().string();

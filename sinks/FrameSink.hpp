@@ -2,10 +2,12 @@
 //   -o out/        image sequence in the TUM layout: the input's frame names, rgb.txt, depth/
 //                  depth.txt and associations.txt (PNG, or EXR when the output is linear HDR)
 //   -o out.mp4     video (.mp4 H.264, .mkv FFV1, .webm VP9, .avi) through cv::VideoWriter
-//   -o out.png     a single frame (the last one written wins); -o out.exr the same, linear float
+//   -o out.png     a single frame (the last one written wins; defocus refuses a clip of several
+//                  frames); -o out.exr the same, linear float
 //   -o /dev/video10  a virtual camera (v4l2loopback), YUYV
-// An output that exists is refused (SinkError) unless SinkOptions::overwrite; every file is
-// written under a temporary name in its folder and renamed when complete.
+// An output that exists is refused (SinkError) unless SinkOptions::overwrite, and so is one whose
+// folder is missing (a folder output's own last folder is made); every file is written under a
+// temporary name in its folder and renamed when complete.
 #pragma once
 
 #include <filesystem>
@@ -84,6 +86,11 @@ std::unique_ptr<FrameSink> openSink(const SinkOptions& options);
 /// holds anything) and `overwrite` is false. For outputs besides the main one (contact sheet,
 /// timings JSON), checked before any frame is processed.
 void refuseExisting(const std::filesystem::path& file, bool overwrite);
+
+/// Throws SinkError "cannot write 'FILE': folder 'DIR' does not exist" when the folder an output
+/// goes into is missing. A folder output (`isFolder`) may be missing itself, as its sink makes that
+/// last folder; never a whole path, which a typo would create.
+void requireParentFolder(const std::filesystem::path& output, bool isFolder);
 
 /// Writes `contents` to `file` under a temporary name in the same folder and renames it into
 /// place, so no reader ever sees a half-written file. Throws SinkError naming the file.

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <mutex>
 #include <system_error>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -83,12 +84,20 @@ bool isTagNotice(const char* line)
     return std::strncmp(line, "OpenCV: FFMPEG: tag 0x", 22) == 0 && std::strstr(line, "is not supported with codec id");
 }
 
+/// A line of FFmpeg's log ("[mp4 @ 0x55d0...] Could not find tag for codec ffv1 ...") or of
+/// OpenCV's ("[ WARN:0@0.1] ...", "OpenCV: FFMPEG: ...").
+bool isLibraryLine(const char* line)
+{
+    return line[0] == '[' || std::strncmp(line, "OpenCV:", 7) == 0;
+}
+
 /// Runs `open` with file descriptor 2 sent to a temporary file, then copies what was caught to
 /// standard error but OpenCV's tag notice (isTagNotice), so that a clean run prints only the
-/// program's own lines. What other threads write to standard error meanwhile is passed on late,
-/// not lost. Without a temporary file or a spare descriptor it just runs `open`.
+/// program's own lines; with `quiet`, the libraries' lines (isLibraryLine) go to the debug log.
+/// What other threads write to standard error meanwhile is passed on late, not lost. Without a
+/// temporary file or a spare descriptor it just runs `open`.
 template <class Open>
-bool withoutTagNotice(Open&& open)
+bool withoutTagNotice(Open&& open, bool quiet)
 {
     static std::mutex mutex; // one redirection at a time (--batch --in-flight opens in threads)
     const std::lock_guard lock(mutex);
@@ -105,6 +114,7 @@ bool withoutTagNotice(Open&& open)
     struct Restore {
         int saved;
         std::FILE* caught;
+        bool quiet;
         ~Restore()
         {
             std::fflush(stderr);
@@ -112,12 +122,15 @@ bool withoutTagNotice(Open&& open)
             ::close(saved);
             std::rewind(caught);
             char line[4096];
-            while (std::fgets(line, sizeof line, caught))
-                if (!isTagNotice(line))
+            while (std::fgets(line, sizeof line, caught)) {
+                if (quiet && isLibraryLine(line))
+                    spdlog::debug("{}", std::string_view(line).substr(0, std::strcspn(line, "\n")));
+                else if (!isTagNotice(line))
                     std::fputs(line, stderr);
+            }
             std::fclose(caught);
         }
-    } restore{saved, caught};
+    } restore{saved, caught, quiet};
     return open();
 }
 
@@ -157,7 +170,7 @@ VideoSink::VideoSink(fs::path file, double fps, const std::string& codec) : file
     for (const std::string& candidate : codecs) {
         const std::string fourcc = findCodec(candidate)->fourcc;
         cv::VideoWriter writer;
-        const bool opened = openWriter(writer, fourcc, probeSize);
+        const bool opened = openWriter(writer, fourcc, probeSize, true);
         writer.release();
         fs::remove(partial_, ec);
         if (opened) {
@@ -184,7 +197,7 @@ VideoSink::~VideoSink()
     }
 }
 
-bool VideoSink::openWriter(cv::VideoWriter& writer, const std::string& fourcc, cv::Size size) const
+bool VideoSink::openWriter(cv::VideoWriter& writer, const std::string& fourcc, cv::Size size, bool probe) const
 {
     // FFmpeg directly: with CAP_ANY a failed open falls through to GStreamer, which only adds
     // noise to the log.
@@ -193,7 +206,7 @@ bool VideoSink::openWriter(cv::VideoWriter& writer, const std::string& fourcc, c
         return withoutTagNotice([&] {
             return writer.open(partial_.string(), api,
                                cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]), fps_, size, true);
-        });
+        }, probe);
     } catch (const cv::Exception& e) {
         spdlog::debug("video '{}': {} failed to open: {}", file_.string(), fourcc, e.err);
         return false;

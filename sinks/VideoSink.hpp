@@ -40,7 +40,9 @@ public:
     const std::string& codec() const { return codec_; }
 
 private:
-    bool openWriter(cv::VideoWriter& writer, const std::string& fourcc, cv::Size size) const;
+    /// `probe`: the constructor trying a codec; what FFmpeg says of one that does not open goes to
+    /// the debug log, not standard error (the constructor's error says it).
+    bool openWriter(cv::VideoWriter& writer, const std::string& fourcc, cv::Size size, bool probe = false) const;
 
     std::filesystem::path file_;
     std::filesystem::path partial_;

@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "sources/FolderPairSource.hpp"
 #include "sources/SingleImageSource.hpp"
@@ -82,8 +83,11 @@ std::unique_ptr<FrameSource> openSource(const SourceOptions& options)
     }
     if (fs::is_regular_file(input, ec)) {
         const double scale = options.depthScale.value_or(defaultUnitsPerMetre);
-        if (isVideoFile(input))
+        if (isVideoFile(input)) {
+            if (!options.depth) // a depth folder or depth.txt went to openStreamSource
+                spdlog::warn("video '{}': no depth given; its frames pass through in focus", input.string());
             return std::make_unique<VideoFileSource>(input, options.depth, scale);
+        }
         if (options.depth && fs::is_directory(*options.depth, ec))
             throw SourceError(fmt::format(
                 "input '{}' is one image but depth '{}' is a folder; give one depth image",

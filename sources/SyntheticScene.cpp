@@ -351,7 +351,7 @@ std::vector<std::string> validate(const SyntheticSettings& s)
     std::vector<std::string> issues;
     const auto outside = [&](const char* name, double value, double lo, double hi) {
         if (!(value >= lo && value <= hi))
-            issues.push_back(fmt::format("{} {} is outside [{}, {}]", name, value, lo, hi));
+            issues.push_back(fmt::format("{} must be between {} and {}, not {}", name, lo, hi, value));
     };
     outside("width", s.width, 16, 4096);
     outside("height", s.height, 16, 4096);

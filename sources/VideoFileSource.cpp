@@ -42,11 +42,10 @@ VideoFileSource::VideoFileSource(std::filesystem::path file,
     const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
     if (std::isfinite(count) && count >= 1.0)
         frameCount_ = static_cast<std::size_t>(count);
+    // Without depthFile, the depth comes from elsewhere (PairedSource: a folder or depth.txt) or
+    // there is none: openSource, which knows which, says so.
     if (depthFile_)
         depth_ = readDepth(*depthFile_, unitsPerMetre);
-    else
-        spdlog::warn("video '{}': no depth given; its frames pass through in focus",
-                     file_.string());
 }
 
 std::optional<Frame> VideoFileSource::next()

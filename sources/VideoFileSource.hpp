@@ -16,8 +16,9 @@ namespace defocus {
 class VideoFileSource final : public FrameSource {
 public:
     /// Opens the container at once (SourceError naming the file when no backend decodes it).
-    /// `depthFile`: one depth image for every frame (a static camera), or none: frames pass
-    /// through in focus. A depth folder is rejected: per-frame depth for video is not supported.
+    /// `depthFile`: one depth image for every frame (a static camera), or none: frames come
+    /// without depth (a PairedSource adds a depth folder's or depth.txt's; alone, they pass
+    /// through in focus).
     VideoFileSource(std::filesystem::path file, std::optional<std::filesystem::path> depthFile,
                     double unitsPerMetre);
 

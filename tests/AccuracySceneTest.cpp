@@ -71,7 +71,7 @@ TEST(AccuracyScene, EachBadFieldIsNamed)
         {replaced(kGood, R"("truth": "t.exr",)", ""), "scenes/x/scene.json: missing field 'truth'"},
         {replaced(kGood, R"("fNumber": 1.8,)", ""), "missing field 'lens.fNumber'"},
         {replaced(kGood, R"("fNumber": 1.8)", R"("fNumber": "1.8")"), "'lens.fNumber' must be a number"},
-        {replaced(kGood, R"("fNumber": 1.8)", R"("fNumber": 0.5)"), "'lens.fNumber': --f-number 0.5 is outside"},
+        {replaced(kGood, R"("fNumber": 1.8)", R"("fNumber": 0.5)"), "'lens.fNumber': --f-number must be between 0.7 and 64, not 0.5"},
         {replaced(kGood, R"("focusM": 1.2)", R"("focusM": 0.01)"), "'lens.focusM'"},
         {replaced(kGood, R"("blades": 6)", R"("blades": 5)"), "'lens.blades' is 5; the filter draws 6-bladed"},
         {replaced(kGood, R"("focal-length")", R"("sensor")"), "'lens.fieldOfView' is 'sensor'"},

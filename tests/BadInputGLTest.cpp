@@ -60,6 +60,7 @@ TEST_F(BadInputCliGLTest, BrokenFrameMidClipKeepsThePlayableVideoBeforeIt)
 {
     const fs::path dir = makeClipWithBrokenFrame("CliGL_midclip_video");
     const fs::path video = dir / "out" / "clip.avi";
+    fs::create_directory(dir / "out"); // defocus makes no missing folder above a file output
     const CliResult r = runDefocus(fmt::format("'{}' --depth '{}' --focus 1 -o '{}'", (dir / "rgb").string(),
                                                (dir / "depth").string(), video.string()));
     EXPECT_EQ(r.exitCode, 1) << r.output;

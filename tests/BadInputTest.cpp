@@ -439,5 +439,109 @@ TEST(BadInputCli, CorruptImageAndMismatchedDepthFailBeforeAnyOutput)
     EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"photo.png", "square.png"})) << r.output;
 }
 
+// ---- Requests the clip cannot meet: refused before any frame (and before GL), nothing written ----
+
+/// A folder pair of three 64x48 frames: dir/rgb and dir/depth.
+fs::path threeFrames(const std::string& name)
+{
+    const fs::path dir = test::scratchDir(name);
+    for (int k = 0; k < 3; ++k) {
+        writeImage(dir / "rgb" / fmt::format("{}.png", k), colourFrame());
+        writeImage(dir / "depth" / fmt::format("{}.png", k), depthFrame());
+    }
+    return dir;
+}
+
+std::string clipOf(const fs::path& dir)
+{
+    return quoted(dir / "rgb") + " --depth " + quoted(dir / "depth");
+}
+
+/// Lines of `text` that hold "error".
+long errorLines(const std::string& text)
+{
+    std::istringstream lines(text);
+    long count = 0;
+    for (std::string line; std::getline(lines, line);)
+        count += line.find("error") != std::string::npos;
+    return count;
+}
+
+// Defect: a one-image output (-o x.png, x.exr) of a clip of several frames rendered every frame and
+// kept the last without a word. Refused in one line that says what to do instead.
+TEST(BadRequestCli, OneImageOutputOfSeveralFramesIsRefused)
+{
+    const fs::path dir = threeFrames("Cli_one_image");
+    for (const std::string name : {"out.png", "out.exr"}) {
+        const CliResult r = runDefocus(clipOf(dir) + " -o " + quoted(dir / name));
+        EXPECT_EQ(r.exitCode, 1) << r.output;
+        EXPECT_EQ(errorLines(r.output), 1) << r.output;
+        EXPECT_CONTAINS(r.output, "-o '" + (dir / name).string() + "' holds one image but '" + (dir / "rgb").string() +
+                                      "' gives 3 frames: write them to a folder");
+        EXPECT_CONTAINS(r.output, "--start N --frames 1");
+    }
+    const CliResult every = runDefocus(clipOf(dir) + " --every 2 -o " + quoted(dir / "out.png"));
+    EXPECT_CONTAINS(every.output, "gives 2 frames"); // frames 0 and 2
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"depth", "rgb"})) << every.output;
+}
+
+// Defect: --contact-frame beyond the clip (or one --every skips) warned and exited 0 without the
+// sheet, after rendering the whole clip.
+TEST(BadRequestCli, ContactFrameTheClipNeverGivesIsRefused)
+{
+    const fs::path dir = threeFrames("Cli_contact_frame");
+    const std::string sheet = " --contact-sheet " + quoted(dir / "sheet.png");
+    CliResult r = runDefocus(clipOf(dir) + " -o " + quoted(dir / "out/") + sheet + " --contact-frame 5");
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_EQ(errorLines(r.output), 1) << r.output;
+    EXPECT_CONTAINS(r.output, "--contact-frame 5 is beyond the 3 frames of '" + (dir / "rgb").string() + "' (0 to 2)");
+    r = runDefocus(clipOf(dir) + " -o " + quoted(dir / "out/") + sheet + " --contact-frame 1 --every 2");
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_CONTAINS(r.output, "--contact-frame 1 is not among the frames --start 0 --every 2 take (0, 2, ...)");
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"depth", "rgb"})) << r.output;
+}
+
+// Defect: a typo in an output's folder created the whole missing path (-o /nonexistent/dir/x.mp4
+// made /nonexistent/dir/). Only the last folder of a folder output is made.
+TEST(BadRequestCli, MissingOutputFolderIsAnErrorNotATree)
+{
+    const fs::path dir = threeFrames("Cli_missing_folder");
+    const fs::path missing = dir / "typo" / "deeper";
+    for (const std::string& output : {(missing / "x.mp4").string(), (missing / "x.png").string(), missing.string() + "/"}) {
+        const CliResult r = runDefocus(clipOf(dir) + " --frames 1 -o " + quoted(fs::path(output)));
+        EXPECT_EQ(r.exitCode, 1) << r.output;
+        EXPECT_EQ(errorLines(r.output), 1) << r.output;
+        const fs::path folder = output.back() == '/' ? dir / "typo" : missing;
+        EXPECT_CONTAINS(r.output, "cannot write '" + output + "': folder '" + folder.string() + "' does not exist");
+    }
+    const CliResult sheet = runDefocus(clipOf(dir) + " -o " + quoted(dir / "out/") + " --contact-sheet " +
+                                       quoted(missing / "sheet.png"));
+    EXPECT_EQ(sheet.exitCode, 1) << sheet.output;
+    EXPECT_CONTAINS(sheet.output, "folder '" + missing.string() + "' does not exist");
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"depth", "rgb"})) << sheet.output;
+}
+
+// Defect: -o or INPUT beside --batch (whose manifest names them), and --shard, --redo,
+// --report-dir or --in-flight without it, silently ignored.
+TEST(BadRequestCli, OptionsThatWouldBeIgnoredBesideOrWithoutBatchAreRefused)
+{
+    const fs::path dir = threeFrames("Cli_batch_options");
+    const std::string manifest = quoted(dir / "clips.tsv");
+    for (const std::string& arguments :
+         {"--batch " + manifest + " -o " + quoted(dir / "x.mp4"), "--batch " + manifest + " " + clipOf(dir),
+          "--batch " + manifest + " --report " + quoted(dir / "r.json")}) {
+        const CliResult r = runDefocus(arguments);
+        EXPECT_EQ(r.exitCode, 2) << arguments << "\n" << r.output;
+        EXPECT_EQ(errorLines(r.output), 1) << r.output;
+        EXPECT_CONTAINS(r.output, "does not go with --batch");
+    }
+    for (const std::string& option : {std::string("--shard 0/2"), std::string("--redo"), "--report-dir " + quoted(dir), std::string("--in-flight 2")}) {
+        const CliResult r = runDefocus(clipOf(dir) + " -o " + quoted(dir / "out/") + " " + option);
+        EXPECT_EQ(r.exitCode, 2) << option << "\n" << r.output;
+        EXPECT_CONTAINS(r.output, option.substr(0, option.find(' ')) + " is an option of --batch MANIFEST");
+    }
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"depth", "rgb"}));
+}
+
 } // namespace
 } // namespace defocus

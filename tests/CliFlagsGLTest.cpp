@@ -557,8 +557,8 @@ TEST_F(CliFlags, AlwaysOnRunsEveryPassWithTheSameResult)
 }
 
 // Defect: --contact-sheet not written, or --contact-frame ignored; a frame index beyond the clip
-// silently writes nothing: it must warn on stderr, naming the option.
-TEST_F(CliFlags, ContactSheetOfTheChosenFrameAndAWarningBeyondTheClip)
+// writes nothing and exits 0: it must fail (1) in one line naming the option, before any frame.
+TEST_F(CliFlags, ContactSheetOfTheChosenFrameAndAnErrorBeyondTheClip)
 {
     const std::string clip = fmt::format("'{}' --depth '{}' --focus 1 --f-number 1.4 -q", file("clip/rgb").string(),
                                          file("clip/depth").string());
@@ -578,9 +578,10 @@ TEST_F(CliFlags, ContactSheetOfTheChosenFrameAndAWarningBeyondTheClip)
     const fs::path beyond = file("sheet5.png");
     const Ran r = defocus(clip + " -o '" + file("s5/").string() + "' --contact-sheet '" + beyond.string() +
                           "' --contact-frame 5");
-    EXPECT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_NE((r.err + r.out).find("warning: --contact-frame 5 is beyond"), std::string::npos) << r.err;
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_NE(r.err.find("error: --contact-frame 5 is beyond the 2 frames of"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(beyond));
+    EXPECT_FALSE(fs::exists(file("s5"))) << "refused before the output is made";
 }
 
 // Defect: --focus-point ignored (the centre measured): at a pixel of the near plane the automatic
@@ -596,6 +597,17 @@ TEST_F(CliFlags, FocusPointMeasuresTheFocusThere)
     };
     EXPECT_NE(focus("20,60").find("frame 0: focus 0.6000 m"), std::string::npos) << focus("20,60");
     EXPECT_NE(focus("140,60").find("frame 0: focus 3.0000 m"), std::string::npos) << focus("140,60");
+    // Defect: a point outside the frame accepted (its window clamped to the border, or empty) and
+    // the run exiting 0: it is refused in one line naming the option and the frame's size.
+    const Ran outside = defocus(fmt::format("'{}' --depth '{}' --focus-point 161,60 -q -o '{}'",
+                                            file("colour.png").string(), file("near_far.png").string(),
+                                            file("outside.png").string()));
+    EXPECT_EQ(outside.exitCode, 1) << outside.err;
+    EXPECT_NE(outside.err.find("error: --focus-point 161,60 is outside the 161x121 frame (X 0 to 160, Y 0 to "
+                               "120)"),
+              std::string::npos)
+        << outside.err;
+    EXPECT_FALSE(fs::exists(file("outside.png")));
 }
 
 // Defect: --tau ignored: tracking focus jumps with the depth (1 m, then 3 m) at once with --tau
@@ -874,8 +886,8 @@ TEST_F(CliFlags, EveryOptionInTheHelpHasATest)
         {"--precision", "CliFlags.PrecisionSetsTheTargetFormat"},
         {"--resolution", "CliFlags.ResolutionHalfKeepsTheSizeAndTheInFocusPixels"},
         {"--view", "CliFlags.ViewWritesEachStage"},
-        {"--contact-sheet", "CliFlags.ContactSheetOfTheChosenFrameAndAWarningBeyondTheClip"},
-        {"--contact-frame", "CliFlags.ContactSheetOfTheChosenFrameAndAWarningBeyondTheClip"},
+        {"--contact-sheet", "CliFlags.ContactSheetOfTheChosenFrameAndAnErrorBeyondTheClip"},
+        {"--contact-frame", "CliFlags.ContactSheetOfTheChosenFrameAndAnErrorBeyondTheClip"},
         {"--frames", "SyntheticSceneGLTest (--demo --frames 3)"},
         {"--start", "CliGLTest StartEveryAndKeyedFocusPerFrame"},
         {"--every", "CliGLTest StartEveryAndKeyedFocusPerFrame"},
@@ -908,6 +920,7 @@ TEST_F(CliFlags, EveryOptionInTheHelpHasATest)
         {"--redo", "CliFlags.BatchReportDirInFlightAndRedo"},
         {"--report-dir", "CliFlags.BatchReportDirInFlightAndRedo"},
         {"--in-flight", "CliFlags.BatchReportDirInFlightAndRedo"},
+        {"--progress-interval", "exit-status-test.sh (progress lines in a log)"},
     };
     const Ran help = defocus("--help");
     ASSERT_EQ(help.exitCode, 0);

@@ -163,7 +163,7 @@ TEST(DisplayHud, BandFollowsTheStatus)
     HudStatus b = a;
     b.view = View::Coc;
     b.focusM = 3.25;
-    b.message = "clamped: --f-number 71.8 is outside [0.7, 64]";
+    b.message = "clamped: --f-number must be between 0.7 and 64, not 71.8";
     b.warning = true;
     const cv::Mat shownA = composeHud(frame, a), shownB = composeHud(frame, b);
     // Narrow frames are padded so the HUD fits.

@@ -82,7 +82,7 @@ TEST_F(Library, SettingsErrorsSpeakTheCommandLinesWords)
         filter_->setSettings(bad);
         FAIL() << "f/0.5 accepted";
     } catch (const defocus::SettingsError& error) {
-        EXPECT_STREQ(error.what(), "--f-number 0.5 is outside [0.7, 64]");
+        EXPECT_STREQ(error.what(), "--f-number must be between 0.7 and 64, not 0.5");
     }
     EXPECT_EQ(filter_->settings().lens.fNumber, 1.4) << "a refused change must leave the settings as they were";
     bad = settings_;
@@ -94,7 +94,7 @@ TEST_F(Library, SettingsErrorsSpeakTheCommandLinesWords)
     const auto issues = defocus::check(clamped, true);
     ASSERT_EQ(issues.size(), 2u);
     EXPECT_EQ(issues[0], "--focus 0.01 m must be farther than the focal length (0.05 m)");
-    EXPECT_EQ(issues[1], "--samples 1 is outside [2, 64]");
+    EXPECT_EQ(issues[1], "--samples must be between 2 and 64, not 1");
     EXPECT_EQ(*clamped.quality.samples, 2);
     EXPECT_GT(clamped.lens.focusM, 0.05);
     EXPECT_TRUE(defocus::check(clamped).empty()) << "clamped settings are valid";

@@ -341,6 +341,7 @@ TEST(SingleImageSink, PngHoldsTheLastFrameWritten)
 {
     const fs::path dir = test::scratchDir("Sink_single_png");
     const fs::path file = dir / "nested" / "out.png";
+    fs::create_directory(dir / "nested"); // its folder must exist (OpenSink.MakesOnlyTheLastFolderOfAFolderOutput)
     const std::unique_ptr<FrameSink> sink = openSink({file, 30.0, false});
     EXPECT_EQ(sink->encoding(), SinkEncoding::Srgb8);
     sink->write(testFrame(0));
@@ -378,6 +379,25 @@ TEST(OpenSink, UnknownOrMissingExtensionIsASinkError)
     const std::string fps = openError({dir / "out.mp4", 0.0, false});
     EXPECT_NE(fps.find("frame rate"), std::string::npos) << fps;
     EXPECT_TRUE(fileNames(dir).empty());
+}
+
+// Defect caught: a typo in an output's path creating the whole missing tree (-o /nonexistent/dir/
+// x.mp4 made /nonexistent/dir/). A folder output's own last folder is made, nothing above it.
+TEST(OpenSink, MakesOnlyTheLastFolderOfAFolderOutput)
+{
+    const fs::path dir = test::scratchDir("Sink_missing_folders");
+    for (const fs::path& file : {dir / "typo" / "x.mp4", dir / "typo" / "x.png", dir / "typo" / "x.exr"}) {
+        const std::string error = openError({file, 30.0, false});
+        EXPECT_NE(error.find("folder '" + (dir / "typo").string() + "' does not exist"), std::string::npos) << error;
+    }
+    const std::string deeper = openError({dir.string() + "/typo/frames/", 30.0, false});
+    EXPECT_NE(deeper.find("folder '" + (dir / "typo").string() + "' does not exist"), std::string::npos) << deeper;
+    EXPECT_TRUE(fileNames(dir).empty());
+
+    const std::unique_ptr<FrameSink> frames = openSink({dir.string() + "/frames/", 30.0, false});
+    frames->write(testFrame(0));
+    frames->finish();
+    EXPECT_EQ(fileNames(dir / "frames"), (std::vector<std::string>{"frame_000000.png", "rgb.txt"}));
 }
 
 } // namespace

@@ -1,10 +1,12 @@
 // Streams without a camera: V4L2 pixel format conversions against hand-computed values, a video
 // clip the test writes itself, depth from another source paired by index and by timestamp, and
 // the errors of camera paths that are no cameras. Capture from real drivers: tests/v4l2_vm_probe.cpp.
+#include <algorithm>
 #include <cstdint>
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,8 @@
 #include <linux/videodev2.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include "sources/FrameSource.hpp"
 #include "sources/PairedSource.hpp"
@@ -229,6 +233,34 @@ SourceOptions optionsFor(fs::path input, std::optional<fs::path> depth = std::nu
     options.input = std::move(input);
     options.depth = std::move(depth);
     return options;
+}
+
+/// What spdlog logs while `open` runs.
+std::string logOf(const std::function<void()>& open)
+{
+    std::ostringstream text;
+    const auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text);
+    auto& sinks = spdlog::default_logger()->sinks();
+    sinks.push_back(sink);
+    open();
+    sinks.erase(std::remove(sinks.begin(), sinks.end(), sink), sinks.end());
+    return text.str();
+}
+
+// Defect: a video with a depth folder or depth.txt announced as "no depth given; its frames pass
+// through in focus" while every frame is blurred with that depth; a video alone must still say it.
+TEST(PairedSource, OnlyAVideoWithoutDepthSaysItPassesThroughInFocus)
+{
+    const fs::path dir = test::scratchDir("streams_depth_message");
+    const fs::path clip = writeClip(dir);
+    writeDepthFolder(dir / "depth", clipFrames, {clipWidth, clipHeight});
+    std::ofstream(dir / "depth.txt") << "0.0 depth/d0.png\n";
+    for (const fs::path& depth : {dir / "depth", dir / "depth.txt"}) {
+        const std::string log = logOf([&] { openSource(optionsFor(clip, depth)); });
+        EXPECT_EQ(log.find("no depth"), std::string::npos) << depth << ": " << log;
+    }
+    const std::string alone = logOf([&] { openSource(optionsFor(clip)); });
+    EXPECT_NE(alone.find("no depth given; its frames pass through in focus"), std::string::npos) << alone;
 }
 
 TEST(VideoFileSource, ReadsAClipItWrote)

@@ -35,7 +35,7 @@ class DEFOCUS_API Error : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
 };
-/// A setting out of range, with the command line's message ("--f-number 0.5 is outside [0.7, 64]").
+/// A setting out of range, with the command line's message ("--f-number must be between 0.7 and 64, not 0.5").
 class DEFOCUS_API SettingsError : public Error {
 public:
     using Error::Error;

@@ -130,7 +130,7 @@ struct Settings {
 };
 
 /// Checks every field against its range, with the command line's words: each problem is one
-/// message such as "--f-number 0.5 is outside [0.7, 64]"; none means valid. With `clamp`, each
+/// message such as "--f-number must be between 0.7 and 64, not 0.5"; none means valid. With `clamp`, each
 /// value out of range is replaced by the nearest allowed one (the messages say what was wrong).
 DEFOCUS_API std::vector<std::string> check(Settings& settings, bool clamp = false);
 
