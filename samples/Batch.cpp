@@ -440,10 +440,10 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
             }
             const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             if (outcome.status != kExitDone && outcome.status != kExitBadInput) {
-                // Stopped or GL lost: nothing of this clip may look done; a rerun does it again.
-                const std::size_t removed = removePartialOutput(clip.output);
-                spdlog::warn("clip {} ({}): not finished (status {}); {} partial file{} removed, no report", clip.index,
-                             clip.outputAsWritten, outcome.status, removed, removed == 1 ? "" : "s");
+                // Stopped or GL lost: the runner wrote nothing under the output's name; with no
+                // report, a rerun does the clip again.
+                spdlog::warn("clip {} ({}): not finished (status {}), no report: a rerun does it", clip.index,
+                             clip.outputAsWritten, outcome.status);
                 if (outcome.status == kExitUnavailable)
                     glFailed = true;
                 const std::lock_guard guard(lock);
@@ -504,48 +504,6 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
     if (glFailed)
         return kExitUnavailable;
     return failed > 0 ? kExitBadInput : kExitDone;
-}
-
-std::size_t removePartialOutput(const fs::path& output)
-{
-    std::error_code error;
-    fs::path path = output;
-    if (!path.has_filename())
-        path = path.parent_path();
-    if (fs::is_regular_file(path, error))
-        return fs::remove(path, error) ? 1 : 0;
-    if (!fs::is_directory(path, error))
-        return 0;
-    // A folder output (TUM layout): the files its lists name, the lists, and files still under a
-    // temporary name (".NAME.partial.EXT"); then depth/ and the folder when that empties them.
-    std::size_t removed = 0;
-    const auto remove = [&](const fs::path& file) {
-        if (fs::is_regular_file(file, error) && fs::remove(file, error))
-            ++removed;
-    };
-    for (const char* list : {"rgb.txt", "depth.txt"}) {
-        std::ifstream in(path / list);
-        for (std::string line; std::getline(in, line);) {
-            if (line.empty() || line.front() == '#')
-                continue;
-            std::istringstream fields(line);
-            std::string timestamp, name;
-            if (fields >> timestamp >> name && name.find("..") == std::string::npos && name.front() != '/')
-                remove(path / name);
-        }
-    }
-    for (const char* list : {"rgb.txt", "depth.txt", "associations.txt"})
-        remove(path / list);
-    for (const fs::path& folder : {path / "depth", path})
-        for (const auto& entry : fs::directory_iterator(folder, error)) {
-            const std::string name = entry.path().filename().string();
-            if (name.front() == '.' && name.find(".partial.") != std::string::npos)
-                remove(entry.path());
-        }
-    for (const fs::path& folder : {path / "depth", path})
-        if (fs::is_directory(folder, error) && fs::is_empty(folder, error))
-            fs::remove(folder, error);
-    return removed;
 }
 
 } // namespace defocus::batch

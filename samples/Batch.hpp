@@ -1,7 +1,7 @@
 // Many clips in one process (defocus --batch MANIFEST): the manifest, the share of it one process
 // takes (--shard I/N, or a Slurm array task's index), each clip's report, written last and
-// atomically so that "the report exists" means "the clip is done", and the removal of a clip's
-// partial output. The rendering itself stays in defocus.cpp; nothing here needs GL.
+// atomically so that "the report exists" means "the clip is done". The rendering itself stays in
+// defocus.cpp; nothing here needs GL.
 //
 // Manifest, one clip per line; blank lines and lines starting with '#' are skipped; both forms
 // may be mixed. Relative paths are taken from the manifest's folder.
@@ -108,16 +108,12 @@ struct BatchOptions {
 /// `makeWorker(worker)` on its own thread; a worker that cannot be made (no GL) throws. Clips
 /// with a report are skipped unless `redo`. After each clip: status 0 (done) or 1 (bad input,
 /// which a retry would not mend) writes its report, last; any other status (stopped, GL lost)
-/// removes its partial output and writes none, so a rerun does it again. No new clip starts
+/// writes none, so a rerun does it again (the runner writes nothing under the clip's output name
+/// unless the clip is done). No new clip starts
 /// once `stopRequested()` or once a clip or worker gave 75. Returns the batch's status: the
 /// stop's (130, 143) when stopped, else 75 when GL failed, else 1 when a clip failed, else 0.
 int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
              const std::function<ClipRunner(std::size_t worker)>& makeWorker,
              const std::function<int()>& stopStatus);
-
-/// Removes what a clip that did not finish left at `output`: a file, or a folder output's frames
-/// (those its rgb.txt and depth.txt name, the lists, files under a temporary name) and the folder
-/// when that empties it; other files stay. Never throws; returns how many files it removed.
-std::size_t removePartialOutput(const std::filesystem::path& output);
 
 } // namespace defocus::batch

@@ -13,6 +13,7 @@
 #include <csignal>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <string>
@@ -77,6 +78,7 @@ struct Options : cli::LensNames, cli::QualityNames {
     bool quiet = false;
     bool verbose = false;
     bool overwrite = false;   ///< -y: replace outputs that exist
+    bool keepPartial = false; ///< --keep-partial: a failed or stopped run's frames as OUTPUT.partial
     std::string codec;        ///< --codec, "" = the container's default
     std::string imageFormat = "png"; ///< --image-format of a folder output
     // Many clips (samples/Batch.hpp) and the GPU.
@@ -243,8 +245,10 @@ void fillReport(nlohmann::json& r, const Options& options, const Lens& lens, con
 }
 
 /// The frames of one clip from `source` through the pipeline into `sink`; returns the exit status.
-/// Stops early at SIGINT/SIGTERM (the sink is finalised all the same) or at an error (the frames
-/// before it are kept).
+/// Only a clip that is done puts its output under the final name (sink.finish()). One stopped by
+/// SIGINT/SIGTERM or failed at an error abandons it: nothing is written there, and with
+/// --keep-partial the frames so far are kept under OUTPUT.partial (FrameSink.hpp). A camera has no
+/// end: SIGINT/SIGTERM ends its clip, which is then done.
 int processClip(const Options& options, FrameSource& source, SyntheticSource* demo, FrameSink& sink, Filter& filter,
                 nlohmann::json* report)
 {
@@ -353,11 +357,25 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         if (report)
             (*report)["error"] = fmt::format("frame {}: {}", current, error.what());
     }
-    try {
-        sink.finish();
-    } catch (const std::exception& error) {
-        spdlog::error("{}", error.what());
-        status = cli::statusFor(error);
+    // A camera's clip ends when it is stopped; any other stopped clip is unfinished.
+    const bool cameraEnded = cli::stopRequested() && source.isLive() && status == kExitDone;
+    if (cli::stopRequested() && !cameraEnded)
+        status = cli::stopStatus();
+    if (status == kExitDone && framesIn > 0) {
+        try {
+            sink.finish();
+        } catch (const std::exception& error) {
+            spdlog::error("{}", error.what());
+            status = cli::statusFor(error);
+        }
+    }
+    std::filesystem::path kept;
+    if (status != kExitDone || framesIn == 0) {
+        try {
+            kept = sink.abandon(options.keepPartial);
+        } catch (const std::exception& error) {
+            spdlog::error("{}", error.what());
+        }
     }
     progress.finish();
     const auto lastGpu = filter.finishGpuTimings();
@@ -370,11 +388,17 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     if (!options.contactSheet.empty() && !sheetWritten && status == kExitDone && !cli::stopRequested())
         spdlog::warn("--contact-frame {} is beyond the {} frames read: no contact sheet written to {}",
                      options.contactFrame, framesIn, options.contactSheet);
-    if (cli::stopRequested()) {
-        spdlog::warn("stopped by {} after {} frames; {} is finalised", cli::stopSignal() == SIGINT ? "Ctrl-C" : "SIGTERM",
-                     framesIn, options.output);
-        status = cli::stopStatus();
-    }
+    const char* signalName = cli::stopSignal() == SIGINT ? "Ctrl-C" : "SIGTERM";
+    if (cameraEnded && !options.quiet)
+        spdlog::info("{} ended the camera's clip after {} frames", signalName, framesIn);
+    if (cli::stopRequested() && !cameraEnded)
+        spdlog::warn("stopped by {} after {} frames: {}", signalName, framesIn,
+                     !kept.empty()       ? fmt::format("the frames so far are in {}, not {}", kept.string(), options.output)
+                     : options.keepPartial ? std::string("no frame written, nothing kept")
+                                           : fmt::format("nothing written to {} (--keep-partial keeps the frames so far)",
+                                                         options.output));
+    else if (!kept.empty())
+        spdlog::warn("the frames before the error are in {}, not {}", kept.string(), options.output);
     if (report)
         fillReport(*report, options, lens, filter.rendererInfo(), framesIn, sink, timingLog);
     if (status == kExitDone && framesIn == 0) {
@@ -385,7 +409,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     }
     std::fflush(stdout);
     std::puts(summarise(framesIn, sink.framesWritten(), passMs, totalMs, uploadMs, readbackMs, timed).c_str());
-    if (!options.quiet)
+    if (!options.quiet && status == kExitDone)
         spdlog::info("wrote {}", sink.describe());
     return status;
 }
@@ -513,6 +537,10 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_flag("-y,--overwrite", o.overwrite,
                  "Replace outputs that exist (without it, an existing output is refused); --batch replaces the "
                  "output of each clip it runs (no report yet, or --redo) with or without it");
+    app.add_flag("--keep-partial", o.keepPartial,
+                 "When the run fails or is stopped (Ctrl-C, SIGTERM), keep the frames written so far as "
+                 "OUTPUT.partial (out.partial.mp4, out.partial/); without it nothing is written to OUTPUT "
+                 "then, and what it held before stays");
     app.add_option("--codec", o.codec,
                    "Video codec: h264 (default for .mp4), mp4v, ffv1 (lossless, default for .mkv), vp9 (default "
                    "for .webm), mjpg (default for .avi)")

@@ -6,8 +6,9 @@
 #     clips 0 and 1 (the same input and settings, one in each process) are byte-identical, PNG
 #     frames and MP4 alike.
 #  2. The same again: every clip has a report, so nothing is done twice.
-#  3. One process stopped with SIGTERM in the middle of a clip: exit 143, that clip's frames
-#     removed and no report; the rerun finishes it and skips the clip done before the stop.
+#  3. One process stopped with SIGTERM in the middle of a clip: exit 143, nothing under that
+#     clip's output name (its frames were in a hidden temporary folder, now gone) and no report;
+#     the rerun finishes it and skips the clip done before the stop.
 #   scripts/batch-test.sh build/defocus        (CTest: label batch; exit 77 = skipped)
 set -u
 defocus=$(realpath "${1:?usage: batch-test.sh DEFOCUS_BINARY}")
@@ -68,21 +69,25 @@ echo "batch-test: rerun: all 5 skipped"
 } > long.tsv
 "$defocus" --batch long.tsv -q > stop.log 2>&1 &
 pid=$!
+# Until the clip is done its frames are in the hidden folder beside its output.
 for _ in $(seq 600); do
-  [ "$(frames_on_disk long/second)" -ge 2 ] && break
+  [ "$(frames_on_disk long/.second.partial)" -ge 2 ] && break
   kill -0 "$pid" 2>/dev/null || break
   sleep 0.1
 done
-[ "$(frames_on_disk long/second)" -ge 2 ] || { cat stop.log; fail "never saw the second clip in progress"; }
+[ "$(frames_on_disk long/.second.partial)" -ge 2 ] || { cat stop.log; fail "never saw the second clip in progress"; }
 kill -TERM "$pid"
 wait "$pid"
 status=$?
 [ "$status" -eq 143 ] || { cat stop.log; fail "SIGTERM mid-clip gave exit $status, not 143"; }
 [ -e long/second.report.json ] && fail "the stopped clip has a report"
-[ "$(frames_on_disk long/second)" -eq 0 ] || fail "the stopped clip left $(frames_on_disk long/second) frames"
+[ -e long/second ] && fail "the stopped clip left its output folder"
+[ -e long/.second.partial ] && fail "the stopped clip left its temporary folder"
+grep -q 'clip 1 (long/second/): not finished (status 143), no report' stop.log || { cat stop.log; fail "the batch does not say the clip was stopped"; }
+grep -qi 'finalised\|removed' stop.log && { cat stop.log; fail "the batch speaks of a finalised or removed output"; }
 [ -e long/first.report.json ] || fail "the clip finished before the stop has no report"
 "$defocus" --batch long.tsv -q > resume.log 2>&1 || { cat resume.log; fail "the resumed batch failed"; }
 grep -q 'clip 0 (long/first/): has a report, skipped' resume.log || fail "the resumed batch did not skip the first clip"
 [ "$(frames_on_disk long/second)" -eq 10 ] || fail "the resumed clip has $(frames_on_disk long/second) frames, not 10"
-echo "batch-test: SIGTERM mid-clip: exit 143, partial output removed; the rerun finished it"
+echo "batch-test: SIGTERM mid-clip: exit 143, nothing under the clip's output name; the rerun finished it"
 echo "3 passed, 0 failed"

@@ -4,8 +4,11 @@
 //   -o out.mp4     video (.mp4 H.264, .mkv FFV1, .webm VP9, .avi) through cv::VideoWriter
 //   -o out.png     a single frame (the last one written wins); -o out.exr the same, linear float
 //   -o /dev/video10  a virtual camera (v4l2loopback), YUYV
-// An output that exists is refused (SinkError) unless SinkOptions::overwrite; every file is
-// written under a temporary name in its folder and renamed when complete.
+// An output that exists is refused (SinkError) unless SinkOptions::overwrite. A file output is
+// written under a hidden temporary name beside its final one (.NAME.partial.EXT, a folder's into
+// .NAME.partial/) and renamed into place by finish() only: a run that fails or is stopped calls
+// abandon() instead, so nothing of it stands under the final name and an earlier output there
+// stays; abandon(true) keeps what was written under NAME.partial.EXT (NAME.partial/).
 #pragma once
 
 #include <filesystem>
@@ -45,8 +48,21 @@ public:
         (void)origin;
         write(image);
     }
-    /// Finalises the output (closes the video container). Idempotent; also run by the destructor.
+    /// The run is done: finalises the output (closes the video container, writes a folder's
+    /// lists) and puts it under its final name. Idempotent.
     virtual void finish() = 0;
+    /// The run failed or was stopped: nothing is put under the final name (whatever stood there
+    /// before stays). What was written is removed, or with `keep` finalised under
+    /// partialPath(output), which is returned (empty when nothing was kept: no frame written, or
+    /// not `keep`). Then finish() and abandon() do nothing. A file sink destroyed without
+    /// finish() abandons its output. This default, for outputs without a name (a window, a
+    /// virtual camera), is finish().
+    virtual std::filesystem::path abandon(bool keep)
+    {
+        (void)keep;
+        finish();
+        return {};
+    }
     /// Frames written so far.
     virtual std::size_t framesWritten() const = 0;
     /// One line for logs, e.g. "video 'out.mp4' (mp4v, 30 fps, 120 frames)".
@@ -84,6 +100,14 @@ std::unique_ptr<FrameSink> openSink(const SinkOptions& options);
 /// holds anything) and `overwrite` is false. For outputs besides the main one (contact sheet,
 /// timings JSON), checked before any frame is processed.
 void refuseExisting(const std::filesystem::path& file, bool overwrite);
+
+/// Where abandon(true) keeps an unfinished output: out.mp4 -> out.partial.mp4; a `folder` output
+/// out/ (or out) -> out.partial.
+std::filesystem::path partialPath(const std::filesystem::path& output, bool folder = false);
+/// The hidden temporary name a file sink writes `output` under until finish() renames it:
+/// out.mp4 -> .out.partial.mp4, a folder out/ -> .out.partial (in the same folder as the final
+/// name, so that the rename is atomic).
+std::filesystem::path temporaryPath(const std::filesystem::path& output, bool folder = false);
 
 /// Writes `contents` to `file` under a temporary name in the same folder and renames it into
 /// place, so no reader ever sees a half-written file. Throws SinkError naming the file.

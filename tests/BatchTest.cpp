@@ -1,6 +1,6 @@
 // defocus --batch without GL: the manifest (TSV and JSON lines, per-clip options, what it
 // refuses), the shard a process takes (--shard, Slurm array variables), report paths, the atomic
-// report and the removal of a clip's partial output.
+// report and the batch's statuses.
 #include <atomic>
 #include <chrono>
 #include <fstream>
@@ -209,36 +209,8 @@ TEST(Reports, BuildInfoNamesVersionAndCommit)
     EXPECT_FALSE(info["host"].get<std::string>().empty());
 }
 
-// Defect: a stopped clip's frames left where they look like a finished output, or files that
-// are not the sink's (the user's own) removed with them.
-TEST(PartialOutput, RemovesTheClipsFilesOnly)
-{
-    const fs::path dir = test::scratchDir("BatchPartial");
-    std::ofstream(dir / "clip.mp4") << "x";
-    EXPECT_EQ(removePartialOutput(dir / "clip.mp4"), 1u);
-    EXPECT_FALSE(fs::exists(dir / "clip.mp4"));
-    // A TUM-layout folder as the sequence sink finalises it after a stop: two frames listed, one
-    // still under its temporary name.
-    const fs::path seq = dir / "seq";
-    fs::create_directories(seq / "depth");
-    for (const char* name : {"1.5.png", "2.5.png", "depth/1.5.png", "depth/2.5.png", ".3.5.partial.png"})
-        std::ofstream(seq / name) << "x";
-    std::ofstream(seq / "rgb.txt") << "# color images\n1.5 1.5.png\n2.5 2.5.png\n";
-    std::ofstream(seq / "depth.txt") << "# depth maps\n1.5 depth/1.5.png\n2.5 depth/2.5.png\n";
-    std::ofstream(seq / "associations.txt") << "1.5 1.5.png 1.5 depth/1.5.png\n";
-    EXPECT_EQ(removePartialOutput(dir / "seq/"), 8u);
-    EXPECT_FALSE(fs::exists(seq));
-    fs::create_directories(dir / "mixed");
-    std::ofstream(dir / "mixed" / "0.png") << "x";
-    std::ofstream(dir / "mixed" / "rgb.txt") << "0 0.png\n";
-    std::ofstream(dir / "mixed" / "notes.png") << "x";
-    EXPECT_EQ(removePartialOutput(dir / "mixed"), 2u);
-    EXPECT_TRUE(fs::exists(dir / "mixed" / "notes.png"));
-    EXPECT_EQ(removePartialOutput(dir / "nothing.mp4"), 0u);
-}
-
-/// A manifest of `n` clips writing into `dir`, and a fake worker that "renders" a clip by
-/// writing its output file, or gives the status `statusOf` says.
+/// A manifest of `n` clips writing into `dir`, and a fake worker that gives the status `statusOf`
+/// says and, as the sinks do, writes the clip's output file only when it is done.
 struct FakeBatch {
     fs::path dir;
     std::vector<Clip> clips;
@@ -268,13 +240,15 @@ struct FakeBatch {
                     for (int seen = mostInFlight; now > seen && !mostInFlight.compare_exchange_weak(seen, now);)
                         ;
                     ++runs;
-                    fs::create_directories(clip.output.parent_path());
-                    std::ofstream(clip.output) << "frames";
                     std::this_thread::sleep_for(std::chrono::milliseconds(20));
                     --inFlight;
                     ClipOutcome outcome;
                     const auto found = statusOf.find(clip.index);
                     outcome.status = found == statusOf.end() ? 0 : found->second;
+                    if (outcome.status == 0) {
+                        fs::create_directories(clip.output.parent_path());
+                        std::ofstream(clip.output) << "frames";
+                    }
                     if (outcome.status == 143)
                         stop = 143; // as the signal handler would
                     outcome.report["frames_out"] = 3;
@@ -295,7 +269,6 @@ TEST(RunBatch, StopLeavesUnfinishedClipsToTheRerunAndSkipsDoneOnes)
     EXPECT_EQ(batch.run(), 143);
     EXPECT_TRUE(batch.reported(0));
     EXPECT_FALSE(batch.reported(1));
-    EXPECT_FALSE(fs::exists(batch.clips[1].output)) << "the stopped clip's partial output is removed";
     EXPECT_FALSE(batch.reported(2)) << "no clip starts after the stop";
     EXPECT_EQ(batch.runs, 2);
     std::ifstream in(reportPath(batch.clips[0], {}));
