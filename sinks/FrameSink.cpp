@@ -54,7 +54,7 @@ fs::path partialPath(const fs::path& output, bool folder)
 fs::path temporaryPath(const fs::path& output, bool folder)
 {
     const fs::path partial = partialPath(output, folder);
-    return partial.parent_path() / ("." + partial.filename().string());
+    return partial.parent_path() / fmt::format(".{}", partial.filename().string());
 }
 
 void writeFileAtomically(const fs::path& file, const std::string& contents)
