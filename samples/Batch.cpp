@@ -144,7 +144,8 @@ Clip jsonLine(const std::string& text, const std::string& where, const fs::path&
     const std::string input = text_of("input");
     clip.outputAsWritten = text_of("output");
     clip.input = resolve(base, input);
-    clip.depth = resolve(base, text_of("depth"));
+    const std::string depth = text_of("depth");
+    clip.depth = depth == "-" ? fs::path() : resolve(base, depth);
     clip.output = resolve(base, clip.outputAsWritten);
     if (input.empty())
         throw ManifestError(fmt::format("{}: no \"input\"", where));
@@ -317,6 +318,15 @@ bool hasReport(const fs::path& report)
     return fs::is_regular_file(report, error);
 }
 
+bool isDone(const fs::path& report)
+{
+    std::ifstream in(report);
+    if (!in)
+        return false;
+    const nlohmann::json doc = nlohmann::json::parse(in, nullptr, false);
+    return doc.is_object() && doc.value("status", std::string()) == "done";
+}
+
 void writeReport(const fs::path& path, const nlohmann::json& report)
 {
     const fs::path folder = path.parent_path();
@@ -402,11 +412,14 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
     std::vector<const Clip*> todo;
     std::size_t skipped = 0;
     for (const Clip& clip : clips) {
-        if (!options.redo && hasReport(reportPath(clip, options.reportDir))) {
-            say(fmt::format("clip {} ({}): has a report, skipped", clip.index, clip.outputAsWritten));
+        const fs::path report = reportPath(clip, options.reportDir);
+        if (!options.redo && isDone(report)) {
+            say(fmt::format("clip {} ({}): done before, skipped", clip.index, clip.outputAsWritten));
             ++skipped;
             continue;
         }
+        if (!options.redo && hasReport(report))
+            say(fmt::format("clip {} ({}): failed before, trying again", clip.index, clip.outputAsWritten));
         todo.push_back(&clip);
     }
     const std::string shard = fmt::format("{}/{}", options.shard.index, options.shard.count);
@@ -435,6 +448,7 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
             try {
                 outcome = run(clip);
             } catch (const std::exception& error) {
+                spdlog::error("{}", error.what()); // the runner said nothing of it
                 outcome.status = kExitBadInput;
                 outcome.report["error"] = error.what();
             }
@@ -469,18 +483,20 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
                 report["slurm"] = slurm;
             int status = outcome.status;
             const fs::path path = reportPath(clip, options.reportDir);
+            bool reported = true;
             try {
                 writeReport(path, report);
             } catch (const std::exception& error) {
                 spdlog::error("clip {} ({}): {}", clip.index, clip.outputAsWritten, error.what());
                 status = 1;
+                reported = false;
             }
             if (status == 0)
                 say(fmt::format("clip {} ({}): done in {:.1f} s, report {}", clip.index, clip.outputAsWritten, wall,
                                 path.string()));
-            else
-                spdlog::error("clip {} ({}): failed: {}", clip.index, clip.outputAsWritten,
-                              report.value("error", std::string("see the messages above")));
+            else // the error itself was said once, above
+                spdlog::error("clip {} ({}): failed (exit status {}){}", clip.index, clip.outputAsWritten, status,
+                              reported ? ", report " + path.string() : std::string(", no report"));
             const std::lock_guard guard(lock);
             ++(status == 0 ? done : failed);
         }
@@ -496,7 +512,7 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
             thread.join();
     }
     const std::size_t notStarted = todo.size() - std::min(todo.size(), done + failed + unfinished);
-    say(fmt::format("batch shard {}: {} clips done, {} failed, {} skipped (report there), {} not finished, {} not "
+    say(fmt::format("batch shard {}: {} clips done, {} failed, {} skipped (done before), {} not finished, {} not "
                     "started",
                     shard, done, failed, skipped, unfinished, notStarted));
     if (const int stop = stopStatus(); stop != 0)

@@ -536,7 +536,7 @@ void declareOptions(CLI::App& app, Options& o)
     cli::addCameraOptions(app, o.camera);
     app.add_flag("-y,--overwrite", o.overwrite,
                  "Replace outputs that exist (without it, an existing output is refused); --batch replaces the "
-                 "output of each clip it runs (no report yet, or --redo) with or without it");
+                 "output of each clip it runs (not done yet, or --redo) with or without it");
     app.add_flag("--keep-partial", o.keepPartial,
                  "When the run fails or is stopped (Ctrl-C, SIGTERM), keep the frames written so far as "
                  "OUTPUT.partial (out.partial.mp4, out.partial/); without it nothing is written to OUTPUT "
@@ -558,10 +558,11 @@ void declareOptions(CLI::App& app, Options& o)
                    "renderer, version, commit, exit status");
     app.add_option("--batch", o.batch,
                    "Many clips, one process: MANIFEST has one clip a line, INPUT<TAB>DEPTH<TAB>OUTPUT[<TAB>options] "
-                   "or JSON; each done clip gets OUTPUT.report.json and is skipped by a rerun (README, Many clips)");
+                   "or JSON; each clip gets OUTPUT.report.json; a rerun skips the clips done and tries the failed "
+                   "ones again (README, Many clips)");
     app.add_option("--shard", o.shard,
                    "--batch: only clips k with k % N == I, as I/N [default: the Slurm array task's, else 0/1]");
-    app.add_flag("--redo", o.redo, "--batch: do clips that have a report again");
+    app.add_flag("--redo", o.redo, "--batch: do the clips done before again");
     app.add_option("--report-dir", o.reportDir, "--batch: put the reports here [default: beside each output]");
     app.add_option("--in-flight", o.inFlight, "--batch: clips processed at once, a GL context each, 1..16")
         ->check(CLI::Range(1, 16))
@@ -722,7 +723,7 @@ int runBatchCommand(const Options& global, const std::vector<std::string>& argum
                 try {
                     outcome.status = runClip(o, *filter, &outcome.report);
                 } catch (const std::exception& error) {
-                    spdlog::error("{}", error.what());
+                    spdlog::error("{}", error.what()); // once: runBatch names the clip after it
                     outcome.status = cli::statusFor(error);
                     outcome.report["error"] = error.what();
                 }

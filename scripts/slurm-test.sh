@@ -170,7 +170,7 @@ for k in 0 1 2 3 4 5; do
   done_lines=$(cat task-*.log | grep -c "defocus: clip $k (out/clip$k/): done")
   [ "$done_lines" -eq 1 ] || fail "clip $k was done $done_lines times"
 done
-grep -q "defocus: clip 1 (out/clip1/): has a report, skipped" task-1.log || fail "the requeued task did not skip clip 1"
+grep -q "defocus: clip 1 (out/clip1/): done before, skipped" task-1.log || fail "the requeued task did not skip clip 1"
 grep -q "clip 3 (out/clip3/): not finished (status 143), no report" task-1.log ||
   fail "task 1's log does not say clip 3 was stopped"
 leftovers=$(find out -name '*.tmp-*' | wc -l)

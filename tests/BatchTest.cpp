@@ -1,6 +1,6 @@
 // defocus --batch without GL: the manifest (TSV and JSON lines, per-clip options, what it
 // refuses), the shard a process takes (--shard, Slurm array variables), report paths, the atomic
-// report and the batch's statuses.
+// report and what a rerun does again.
 #include <atomic>
 #include <chrono>
 #include <fstream>
@@ -70,6 +70,9 @@ TEST(Manifest, JsonLinesGiveTheSameOptions)
     const std::set<std::string> options(clips[0].options.begin(), clips[0].options.end());
     EXPECT_EQ(options, (std::set<std::string>{"--focus=1.25", "--quality=high", "--no-near-field",
                                               "--highlight-sprites"}));
+    // Defect: "-" taken as a depth file named '-' in JSON, although it means none in TSV.
+    EXPECT_TRUE(parse(R"({"input": "tum", "depth": "-", "output": "o.mp4"})")[0].depth.empty());
+    EXPECT_EQ(parse(R"({"input": "tum", "depth": "d", "output": "o.mp4"})")[0].depth, fs::path("/data/d"));
 }
 
 // Defect: a bad line accepted, so the batch fails (or writes somewhere wrong) hours later, or an
@@ -319,6 +322,31 @@ TEST(RunBatch, BadClipsAreReportedAndGlFailuresAreRetried)
                   [] { return 0; }),
               75);
     EXPECT_FALSE(noContext.reported(0));
+}
+
+// Defect: a clip whose report says failed taken as done by a rerun (skipped, exit 0, although its
+// input may be there now), or a retried clip not counted in the rerun's status.
+TEST(RunBatch, ClipsThatFailedAreTriedAgainByARerunUntilDone)
+{
+    FakeBatch batch("BatchRunRetry", 3);
+    batch.statusOf[1] = 1; // its input is missing
+    EXPECT_EQ(batch.run(), 1);
+    EXPECT_TRUE(batch.reported(1));
+    EXPECT_FALSE(isDone(reportPath(batch.clips[1], {})));
+    EXPECT_TRUE(isDone(reportPath(batch.clips[0], {})));
+
+    batch.runs = 0;
+    EXPECT_EQ(batch.run(), 1) << "still missing: the rerun fails again";
+    EXPECT_EQ(batch.runs, 1) << "the rerun tries the failed clip, and only it";
+
+    batch.statusOf.clear(); // the input is there now
+    batch.runs = 0;
+    EXPECT_EQ(batch.run(), 0);
+    EXPECT_EQ(batch.runs, 1);
+    EXPECT_TRUE(isDone(reportPath(batch.clips[1], {})));
+    batch.runs = 0;
+    EXPECT_EQ(batch.run(), 0);
+    EXPECT_EQ(batch.runs, 0) << "all done: nothing to do";
 }
 
 // Defect: --jobs 2 running one clip at a time, or two workers taking the same clip.
