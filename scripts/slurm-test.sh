@@ -167,7 +167,7 @@ for k in 0 1 2 3 4 5; do
   grep -q "\"frames_out\": ${frames[$k]}," "$report" || fail "clip $k's report does not count ${frames[$k]} frames out"
   on_disk=$(frames_on_disk "out/clip$k")
   [ "$on_disk" -eq "${frames[$k]}" ] || fail "clip $k has $on_disk frames on disk, not ${frames[$k]}"
-  done_lines=$(cat task-*.log | grep -c "defocus: clip $k (out/clip$k/): done")
+  done_lines=$(cat task-*.log | grep -c "defocus: clip $k (out/clip$k/): done in")
   [ "$done_lines" -eq 1 ] || fail "clip $k was done $done_lines times"
 done
 grep -q "defocus: clip 1 (out/clip1/): done before, skipped" task-1.log || fail "the requeued task did not skip clip 1"
