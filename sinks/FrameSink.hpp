@@ -5,10 +5,11 @@
 //   -o out.png     a single frame (the last one written wins); -o out.exr the same, linear float
 //   -o /dev/video10  a virtual camera (v4l2loopback), YUYV
 // An output that exists is refused (SinkError) unless SinkOptions::overwrite. A file output is
-// written under a hidden temporary name beside its final one (.NAME.partial.EXT, a folder's into
-// .NAME.partial/) and renamed into place by finish() only: a run that fails or is stopped calls
-// abandon() instead, so nothing of it stands under the final name and an earlier output there
-// stays; abandon(true) keeps what was written under NAME.partial.EXT (NAME.partial/).
+// written under a hidden temporary name beside its final one (.NAME.partial.EXT; a folder's into
+// .NAME.partial/, or NAME/.defocus.partial/ when the folder exists) and put in place by finish()
+// only: a run that fails or is stopped calls abandon() instead, so nothing of it stands under the
+// final name and an earlier output there stays; abandon(true) keeps what was written under
+// NAME.partial.EXT (NAME.partial/).
 #pragma once
 
 #include <filesystem>

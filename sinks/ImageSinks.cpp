@@ -142,12 +142,12 @@ cv::Mat tumDepth(const cv::Mat& metres)
 } // namespace
 
 ImageSequenceSink::ImageSequenceSink(fs::path folder, bool linear, double fps)
-    : folder_(folder.has_filename() ? std::move(folder) : folder.parent_path()),
-      work_(temporaryPath(folder_, true)),
-      linear_(linear),
-      fps_(fps > 0.0 ? fps : 30.0)
+    : folder_(folder.has_filename() ? std::move(folder) : folder.parent_path()), linear_(linear), fps_(fps > 0.0 ? fps : 30.0)
 {
+    // Beside a new folder, so that one rename puts it in place; inside one that exists (it may be
+    // a mount point, or the current folder), so that its files can be moved in.
     std::error_code ec;
+    work_ = fs::is_directory(folder_, ec) ? folder_ / ".defocus.partial" : temporaryPath(folder_, true);
     fs::remove_all(work_, ec); // what a killed run left under this output's temporary name
     prepareFolder(work_, folder_);
 }
@@ -244,15 +244,15 @@ void ImageSequenceSink::finish()
         return SinkError(fmt::format("cannot write sequence '{}': moving '{}' into place failed: {}", folder_.string(),
                                      what.string(), ec.message()));
     };
-    // A new or empty folder: one rename (POSIX rename replaces an empty directory).
-    if (!fs::exists(folder_, ec) || (fs::is_directory(folder_, ec) && fs::is_empty(folder_, ec))) {
+    // A new folder: one rename.
+    if (!fs::exists(folder_, ec)) {
         fs::rename(work_, folder_, ec);
         if (ec)
             throw failed(work_);
         return;
     }
-    // A folder that holds files (-y): the frames and depth maps, then the lists, each renamed over
-    // the file of the same name; the folder's other files stay.
+    // A folder that exists (empty, or holding files with -y): the frames and depth maps, then the
+    // lists, each renamed over the file of the same name; the folder's other files stay.
     std::vector<std::string> names;
     for (const Entry& e : entries_) {
         if (!e.depth.empty())

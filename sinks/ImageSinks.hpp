@@ -1,7 +1,8 @@
 // Image outputs: a sequence in a folder laid out as a TUM RGB-D clip (PNG, or EXR when linear), or
 // one image file that each frame replaces.   defocus in/ -o out/   defocus photo.png --depth d.png -o out.exr
-// Both are written under a hidden temporary name beside the output (.out.partial/, .out.partial.png)
-// and put in place by finish(); abandon() leaves the output's name alone (FrameSink.hpp).
+// Both are written under a hidden temporary name beside the output (.out.partial/, .out.partial.png;
+// out/.defocus.partial/ in a folder that exists) and put in place by finish(); abandon() leaves the
+// output's name alone (FrameSink.hpp).
 #pragma once
 
 #include <cstddef>
@@ -18,7 +19,8 @@ namespace defocus {
 /// timestamp, e.g. 1305031102.175304.png; frame_000042.png when the input has no file names),
 /// its depth as a 16-bit PNG at 5000 units per metre in depth/, and rgb.txt, depth.txt and
 /// associations.txt listing them (written when the sequence finishes). The frames go into the
-/// hidden folder .NAME.partial beside `folder`, which finish() renames to `folder`.
+/// hidden folder .NAME.partial beside `folder`, which finish() renames to `folder`; when `folder`
+/// exists, into FOLDER/.defocus.partial, whose files finish() moves into it.
 class ImageSequenceSink final : public FrameSink {
 public:
     /// Creates the temporary folder beside `folder` and checks that it is writable; throws
@@ -32,8 +34,8 @@ public:
     /// A frame with no input behind it: frame_NNNNNN, timestamp index / fps, no depth.
     void write(const cv::Mat& image) override;
     void writeFrame(const cv::Mat& image, const Frame& origin) override;
-    /// Writes the lists and renames the temporary folder to the output folder (which may exist
-    /// empty). Into a folder that holds files (-y), the frames, then the lists, are moved in one by
+    /// Writes the lists and renames the temporary folder to the output folder. Into a folder that
+    /// exists (empty, or holding files with -y), the frames, then the lists, are moved in one by
     /// one; its other files stay. With no frame written, nothing is created (with a warning).
     void finish() override;
     /// Removes the temporary folder, or with `keep` writes its lists and renames it NAME.partial

@@ -387,8 +387,9 @@ TEST(FileSinks, AbandonLeavesTheFinalNameAloneAndKeepsThePartialOnlyWhenAsked)
     EXPECT_EQ(contents(dir / "seq" / "rgb.txt"), "earlier list");
 }
 
-// Defect caught: -y into a folder that holds other files deleting them, or a finished sequence
-// not put in place over the earlier frames and lists.
+// Defect caught: -y into a folder that holds other files deleting them, a finished sequence not
+// put in place over the earlier frames and lists, or the frames for a folder that exists written
+// beside it (its parent may be another file system, as for a mount point, or not writable).
 TEST(ImageSequenceSink, FinishIntoAFolderWithFilesReplacesItsFramesAndListsOnly)
 {
     const fs::path dir = test::scratchDir("Sink_sequence_into");
@@ -398,6 +399,8 @@ TEST(ImageSequenceSink, FinishIntoAFolderWithFilesReplacesItsFramesAndListsOnly)
     options.overwrite = true;
     const std::unique_ptr<FrameSink> sink = openSink(options);
     sink->write(testFrame(0));
+    EXPECT_FALSE(fs::exists(temporaryPath(dir, true)));
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{".defocus.partial", "notes.md", "rgb.txt"}));
     sink->finish();
     EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"frame_000000.png", "notes.md", "rgb.txt"}));
     EXPECT_NE(contents(dir / "rgb.txt").find("frame_000000.png"), std::string::npos);
