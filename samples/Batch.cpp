@@ -144,7 +144,8 @@ Clip jsonLine(const std::string& text, const std::string& where, const fs::path&
     const std::string input = text_of("input");
     clip.outputAsWritten = text_of("output");
     clip.input = resolve(base, input);
-    clip.depth = resolve(base, text_of("depth"));
+    const std::string depth = text_of("depth");
+    clip.depth = depth == "-" ? fs::path() : resolve(base, depth);
     clip.output = resolve(base, clip.outputAsWritten);
     if (input.empty())
         throw ManifestError(fmt::format("{}: no \"input\"", where));
@@ -317,6 +318,15 @@ bool hasReport(const fs::path& report)
     return fs::is_regular_file(report, error);
 }
 
+bool isDone(const fs::path& report)
+{
+    std::ifstream in(report);
+    if (!in)
+        return false;
+    const nlohmann::json doc = nlohmann::json::parse(in, nullptr, false);
+    return doc.is_object() && doc.value("status", std::string()) == "done";
+}
+
 void writeReport(const fs::path& path, const nlohmann::json& report)
 {
     const fs::path folder = path.parent_path();
@@ -402,11 +412,14 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
     std::vector<const Clip*> todo;
     std::size_t skipped = 0;
     for (const Clip& clip : clips) {
-        if (!options.redo && hasReport(reportPath(clip, options.reportDir))) {
-            say(fmt::format("clip {} ({}): has a report, skipped", clip.index, clip.outputAsWritten));
+        const fs::path report = reportPath(clip, options.reportDir);
+        if (!options.redo && isDone(report)) {
+            say(fmt::format("clip {} ({}): done before, skipped", clip.index, clip.outputAsWritten));
             ++skipped;
             continue;
         }
+        if (!options.redo && hasReport(report))
+            say(fmt::format("clip {} ({}): failed before, trying again", clip.index, clip.outputAsWritten));
         todo.push_back(&clip);
     }
     const std::string shard = fmt::format("{}/{}", options.shard.index, options.shard.count);
@@ -435,15 +448,16 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
             try {
                 outcome = run(clip);
             } catch (const std::exception& error) {
+                spdlog::error("{}", error.what()); // the runner said nothing of it
                 outcome.status = kExitBadInput;
                 outcome.report["error"] = error.what();
             }
             const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             if (outcome.status != kExitDone && outcome.status != kExitBadInput) {
-                // Stopped or GL lost: nothing of this clip may look done; a rerun does it again.
-                const std::size_t removed = removePartialOutput(clip.output);
-                spdlog::warn("clip {} ({}): not finished (status {}); {} partial file{} removed, no report", clip.index,
-                             clip.outputAsWritten, outcome.status, removed, removed == 1 ? "" : "s");
+                // Stopped or GL lost: the runner wrote nothing under the output's name; with no
+                // report, a rerun does the clip again.
+                spdlog::warn("clip {} ({}): not finished (status {}), no report: a rerun does it", clip.index,
+                             clip.outputAsWritten, outcome.status);
                 if (outcome.status == kExitUnavailable)
                     glFailed = true;
                 const std::lock_guard guard(lock);
@@ -469,18 +483,20 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
                 report["slurm"] = slurm;
             int status = outcome.status;
             const fs::path path = reportPath(clip, options.reportDir);
+            bool reported = true;
             try {
                 writeReport(path, report);
             } catch (const std::exception& error) {
                 spdlog::error("clip {} ({}): {}", clip.index, clip.outputAsWritten, error.what());
                 status = 1;
+                reported = false;
             }
             if (status == 0)
                 say(fmt::format("clip {} ({}): done in {:.1f} s, report {}", clip.index, clip.outputAsWritten, wall,
                                 path.string()));
-            else
-                spdlog::error("clip {} ({}): failed: {}", clip.index, clip.outputAsWritten,
-                              report.value("error", std::string("see the messages above")));
+            else // the error itself was said once, above
+                spdlog::error("clip {} ({}): failed (exit status {}){}", clip.index, clip.outputAsWritten, status,
+                              reported ? ", report " + path.string() : std::string(", no report"));
             const std::lock_guard guard(lock);
             ++(status == 0 ? done : failed);
         }
@@ -496,7 +512,7 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
             thread.join();
     }
     const std::size_t notStarted = todo.size() - std::min(todo.size(), done + failed + unfinished);
-    say(fmt::format("batch shard {}: {} clips done, {} failed, {} skipped (report there), {} not finished, {} not "
+    say(fmt::format("batch shard {}: {} clips done, {} failed, {} skipped (done before), {} not finished, {} not "
                     "started",
                     shard, done, failed, skipped, unfinished, notStarted));
     if (const int stop = stopStatus(); stop != 0)
@@ -504,48 +520,6 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
     if (glFailed)
         return kExitUnavailable;
     return failed > 0 ? kExitBadInput : kExitDone;
-}
-
-std::size_t removePartialOutput(const fs::path& output)
-{
-    std::error_code error;
-    fs::path path = output;
-    if (!path.has_filename())
-        path = path.parent_path();
-    if (fs::is_regular_file(path, error))
-        return fs::remove(path, error) ? 1 : 0;
-    if (!fs::is_directory(path, error))
-        return 0;
-    // A folder output (TUM layout): the files its lists name, the lists, and files still under a
-    // temporary name (".NAME.partial.EXT"); then depth/ and the folder when that empties them.
-    std::size_t removed = 0;
-    const auto remove = [&](const fs::path& file) {
-        if (fs::is_regular_file(file, error) && fs::remove(file, error))
-            ++removed;
-    };
-    for (const char* list : {"rgb.txt", "depth.txt"}) {
-        std::ifstream in(path / list);
-        for (std::string line; std::getline(in, line);) {
-            if (line.empty() || line.front() == '#')
-                continue;
-            std::istringstream fields(line);
-            std::string timestamp, name;
-            if (fields >> timestamp >> name && name.find("..") == std::string::npos && name.front() != '/')
-                remove(path / name);
-        }
-    }
-    for (const char* list : {"rgb.txt", "depth.txt", "associations.txt"})
-        remove(path / list);
-    for (const fs::path& folder : {path / "depth", path})
-        for (const auto& entry : fs::directory_iterator(folder, error)) {
-            const std::string name = entry.path().filename().string();
-            if (name.front() == '.' && name.find(".partial.") != std::string::npos)
-                remove(entry.path());
-        }
-    for (const fs::path& folder : {path / "depth", path})
-        if (fs::is_directory(folder, error) && fs::is_empty(folder, error))
-            fs::remove(folder, error);
-    return removed;
 }
 
 } // namespace defocus::batch

@@ -1,7 +1,7 @@
 // Many clips in one process (defocus --batch MANIFEST): the manifest, the share of it one process
 // takes (--shard I/N, or a Slurm array task's index), each clip's report, written last and
-// atomically so that "the report exists" means "the clip is done", and the removal of a clip's
-// partial output. The rendering itself stays in defocus.cpp; nothing here needs GL.
+// atomically, and what a rerun does again: every clip whose report does not say done. The
+// rendering itself stays in defocus.cpp; nothing here needs GL.
 //
 // Manifest, one clip per line; blank lines and lines starting with '#' are skipped; both forms
 // may be mixed. Relative paths are taken from the manifest's folder.
@@ -9,8 +9,9 @@
 //               DEPTH empty or '-' for none (TUM folders); each OPTIONS column holds per-clip
 //               options separated by spaces, e.g. "--focus 1.2 --f-number 1.4"
 //   JSON lines: {"input": "...", "depth": "...", "output": "...", "focus": 1.2, "near-field": false}
-//               every key other than input/depth/output is an option: a string or number is its
-//               value, true gives the flag, false its --no- form (or nothing where there is none)
+//               "depth" absent, null, "" or "-" for none, as in TSV; every key other than
+//               input/depth/output is an option: a string or number is its value, true gives
+//               the flag, false its --no- form (or nothing where there is none)
 // Per-clip options are the lens, quality and output options of clipOptions(); the others
 // (--batch, --shard, --report-dir, --egl-device, ...) are the whole run's and are refused here.
 #pragma once
@@ -77,8 +78,11 @@ std::vector<Clip> select(const std::vector<Clip>& all, Shard shard);
 std::filesystem::path reportPath(const Clip& clip, const std::filesystem::path& reportDir);
 /// Throws ManifestError when two clips' reports would be the same file.
 void checkReportPaths(const std::vector<Clip>& clips, const std::filesystem::path& reportDir);
-/// True when the clip has a report: it was done (or failed for good) by an earlier run.
+/// True when the clip has a report, done or failed.
 bool hasReport(const std::filesystem::path& report);
+/// True when the clip's report says "status": "done": an earlier run did it, a rerun skips it.
+/// A failed report is a failure until the clip is done: a rerun tries it again.
+bool isDone(const std::filesystem::path& report);
 /// Writes `report` to a temporary file beside `path`, flushes it to disk and renames it over
 /// `path`, so that `path` is either absent or complete. Creates the folder. Throws
 /// std::runtime_error naming the file when it cannot.
@@ -94,7 +98,9 @@ struct ClipOutcome {
     int status = 0;
     nlohmann::json report = nlohmann::json::object();
 };
-/// Runs clips on one worker; made on the worker's own thread (it owns a GL context there).
+/// Runs clips on one worker; made on the worker's own thread (it owns a GL context there). It
+/// says a clip's error once itself (runBatch names the clip after it), writes nothing under the
+/// clip's output name unless the clip is done, and throws only what it did not say.
 using ClipRunner = std::function<ClipOutcome(const Clip&)>;
 
 struct BatchOptions {
@@ -106,18 +112,14 @@ struct BatchOptions {
 
 /// Runs `clips` (this process's shard) on `options.inFlight` workers, each made by
 /// `makeWorker(worker)` on its own thread; a worker that cannot be made (no GL) throws. Clips
-/// with a report are skipped unless `redo`. After each clip: status 0 (done) or 1 (bad input,
-/// which a retry would not mend) writes its report, last; any other status (stopped, GL lost)
-/// removes its partial output and writes none, so a rerun does it again. No new clip starts
-/// once `stopRequested()` or once a clip or worker gave 75. Returns the batch's status: the
-/// stop's (130, 143) when stopped, else 75 when GL failed, else 1 when a clip failed, else 0.
+/// whose report says done are skipped unless `redo`; those whose report says failed are tried
+/// again (the input may be there now) and counted as done or failed. After each clip: status 0
+/// (done) or 1 (bad input) writes its report, last; any other status (stopped, GL lost) writes
+/// none, so a rerun does it again. No new clip starts once `stopStatus()` is not 0 or once a
+/// clip or worker gave 75. Returns the batch's status: the stop's (130, 143) when stopped, else
+/// 75 when GL failed, else 1 when a clip of this run failed, else 0.
 int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
              const std::function<ClipRunner(std::size_t worker)>& makeWorker,
              const std::function<int()>& stopStatus);
-
-/// Removes what a clip that did not finish left at `output`: a file, or a folder output's frames
-/// (those its rgb.txt and depth.txt name, the lists, files under a temporary name) and the folder
-/// when that empties it; other files stay. Never throws; returns how many files it removed.
-std::size_t removePartialOutput(const std::filesystem::path& output);
 
 } // namespace defocus::batch

@@ -101,7 +101,8 @@ void addDepthScaleOption(CLI::App& app, std::optional<double>& scale);
 std::optional<int> checkLensAndQuality(const LensSettings& lens, const QualitySettings& quality, bool autoFocus);
 
 /// Installs handlers for SIGINT and SIGTERM that only record the signal: the program stops
-/// reading, finalises what it has written and exits with stopStatus().
+/// reading, closes its outputs (defocus puts nothing under an output's name then, README "Exit
+/// status") and exits with stopStatus().
 void catchStopSignals();
 /// True once SIGINT or SIGTERM arrived.
 bool stopRequested();

@@ -12,8 +12,8 @@ enum ExitStatus : int {
     kExitUsage = 2,        ///< the command line (any parse or range error, options that do not go
                            ///< together, an --egl-device the machine does not have)
     kExitUnavailable = 75, ///< no EGL display / GL 4.5 context, or a busy device (sysexits' EX_TEMPFAIL): retry
-    kExitInterrupted = 130,///< Ctrl-C (128 + SIGINT); what was written is finalised
-    kExitTerminated = 143, ///< SIGTERM (128 + SIGTERM), as a scheduler sends at a time limit; finalised
+    kExitInterrupted = 130,///< Ctrl-C (128 + SIGINT); nothing under the output's name (defocus --keep-partial: OUTPUT.partial)
+    kExitTerminated = 143, ///< SIGTERM (128 + SIGTERM), as a scheduler sends at a time limit; as Ctrl-C
 };
 
 } // namespace defocus

@@ -82,6 +82,7 @@ struct Options : cli::LensNames, cli::QualityNames {
     bool verbose = false;
     double progressInterval = 5.0; ///< --progress-interval, seconds
     bool overwrite = false;   ///< -y: replace outputs that exist
+    bool keepPartial = false; ///< --keep-partial: a failed or stopped run's frames as OUTPUT.partial
     std::string codec;        ///< --codec, "" = the container's default
     std::string imageFormat = "png"; ///< --image-format of a folder output
     // Many clips (samples/Batch.hpp) and the GPU.
@@ -312,8 +313,10 @@ void checkAgainstTheClip(const Options& options, std::optional<std::size_t> coun
 }
 
 /// The frames of one clip from `source` through the pipeline into `sink`; returns the exit status.
-/// Stops early at SIGINT/SIGTERM (the sink is finalised all the same) or at an error (the frames
-/// before it are kept).
+/// Only a clip that is done puts its output under the final name (sink.finish()). One stopped by
+/// SIGINT/SIGTERM or failed at an error abandons it: nothing is written there, and with
+/// --keep-partial the frames so far are kept under OUTPUT.partial (FrameSink.hpp). A camera has no
+/// end: SIGINT/SIGTERM ends its clip, which is then done.
 int processClip(const Options& options, FrameSource& source, SyntheticSource* demo, FrameSink& sink, Filter& filter,
                 nlohmann::json* report)
 {
@@ -428,11 +431,25 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         if (report)
             (*report)["error"] = fmt::format("frame {}: {}", current, error.what());
     }
-    try {
-        sink.finish();
-    } catch (const std::exception& error) {
-        spdlog::error("{}", error.what());
-        status = cli::statusFor(error);
+    // A camera's clip ends when it is stopped; any other stopped clip is unfinished.
+    const bool cameraEnded = cli::stopRequested() && source.isLive() && status == kExitDone;
+    if (cli::stopRequested() && !cameraEnded)
+        status = cli::stopStatus();
+    if (status == kExitDone && framesIn > 0) {
+        try {
+            sink.finish();
+        } catch (const std::exception& error) {
+            spdlog::error("{}", error.what());
+            status = cli::statusFor(error);
+        }
+    }
+    std::filesystem::path kept;
+    if (status != kExitDone || framesIn == 0) {
+        try {
+            kept = sink.abandon(options.keepPartial);
+        } catch (const std::exception& error) {
+            spdlog::error("{}", error.what());
+        }
     }
     progress.finish();
     const auto lastGpu = filter.finishGpuTimings();
@@ -448,11 +465,17 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
                       options.contactFrame, read, options.contactSheet);
         status = kExitBadInput;
     }
-    if (cli::stopRequested()) {
-        spdlog::warn("stopped by {} after {} frames; {} is finalised", cli::stopSignal() == SIGINT ? "Ctrl-C" : "SIGTERM",
-                     framesIn, options.output);
-        status = cli::stopStatus();
-    }
+    const char* signalName = cli::stopSignal() == SIGINT ? "Ctrl-C" : "SIGTERM";
+    if (cameraEnded && !options.quiet)
+        spdlog::info("{} ended the camera's clip after {} frames", signalName, framesIn);
+    if (cli::stopRequested() && !cameraEnded)
+        spdlog::warn("stopped by {} after {} frames: {}", signalName, framesIn,
+                     !kept.empty()       ? fmt::format("the frames so far are in {}, not {}", kept.string(), options.output)
+                     : options.keepPartial ? std::string("no frame written, nothing kept")
+                                           : fmt::format("nothing written to {} (--keep-partial keeps the frames so far)",
+                                                         options.output));
+    else if (!kept.empty())
+        spdlog::warn("the frames before the error are in {}, not {}", kept.string(), options.output);
     if (report)
         fillReport(*report, options, lens, filter.rendererInfo(), framesIn, sink, timingLog);
     if (status == kExitDone && framesIn == 0) {
@@ -463,7 +486,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     }
     std::fflush(stdout);
     std::puts(summarise(framesIn, sink.framesWritten(), passMs, totalMs, uploadMs, readbackMs, timed).c_str());
-    if (!options.quiet)
+    if (!options.quiet && status == kExitDone)
         spdlog::info("wrote {}", sink.describe());
     return status;
 }
@@ -603,7 +626,11 @@ void declareOptions(CLI::App& app, Options& o)
     cli::addCameraOptions(app, o.camera);
     app.add_flag("-y,--overwrite", o.overwrite,
                  "Replace outputs that exist (without it, an existing output is refused); --batch replaces the "
-                 "output of each clip it runs (no report yet, or --redo) with or without it");
+                 "output of each clip it runs (not done yet, or --redo) with or without it");
+    app.add_flag("--keep-partial", o.keepPartial,
+                 "When the run fails or is stopped (Ctrl-C, SIGTERM), keep the frames written so far as "
+                 "OUTPUT.partial (out.partial.mp4, out.partial/); without it nothing is written to OUTPUT "
+                 "then, and what it held before stays");
     app.add_option("--codec", o.codec,
                    "Video codec: h264 (default for .mp4), mp4v, ffv1 (lossless, default for .mkv), vp9 (default "
                    "for .webm), mjpg (default for .avi)")
@@ -621,10 +648,11 @@ void declareOptions(CLI::App& app, Options& o)
                    "renderer, version, commit, exit status");
     app.add_option("--batch", o.batch,
                    "Many clips, one process: MANIFEST has one clip a line, INPUT<TAB>DEPTH<TAB>OUTPUT[<TAB>options] "
-                   "or JSON; each done clip gets OUTPUT.report.json and is skipped by a rerun (README, Many clips)");
+                   "or JSON; each clip gets OUTPUT.report.json; a rerun skips the clips done and tries the failed "
+                   "ones again (README, Many clips)");
     app.add_option("--shard", o.shard,
                    "--batch: only clips k with k % N == I, as I/N [default: the Slurm array task's, else 0/1]");
-    app.add_flag("--redo", o.redo, "--batch: do clips that have a report again");
+    app.add_flag("--redo", o.redo, "--batch: do the clips done before again");
     app.add_option("--report-dir", o.reportDir, "--batch: put the reports here [default: beside each output]");
     app.add_option("--in-flight", o.inFlight, "--batch: clips processed at once, a GL context each, 1..16")
         ->check(cli::between(1, 16))
@@ -829,7 +857,7 @@ int runBatchCommand(const Options& global, const std::vector<std::string>& argum
                 try {
                     outcome.status = runClip(o, *filter, &outcome.report);
                 } catch (const std::exception& error) {
-                    spdlog::error("{}", error.what());
+                    spdlog::error("{}", error.what()); // once: runBatch names the clip after it
                     outcome.status = cli::statusFor(error);
                     outcome.report["error"] = error.what();
                 }

@@ -2,7 +2,7 @@
 # `defocus --batch` on one machine through GNU parallel: the manifest split into one shard per
 # process, one process per core (or JOBS), the same contract as a Slurm array (defocus.sbatch).
 #   scripts/batch-parallel.sh clips.tsv [defocus options]          JOBS=4 DEFOCUS=build/defocus ...
-# Rerunning does only the clips without a report. Exit status: 0 when every shard finished, else
+# Rerunning does only the clips not done yet: those without a report, or whose report says failed. Exit status: 0 when every shard finished, else
 # the highest of the shards' statuses (143/130 stopped, 75 no GL, 2 bad command line, 1 a bad clip).
 set -u
 if [ $# -lt 1 ]; then

@@ -6,6 +6,8 @@
 
 namespace defocus {
 
+namespace fs = std::filesystem;
+
 BackgroundSink::BackgroundSink(std::unique_ptr<FrameSink> sink, std::size_t depth)
     : sink_(std::move(sink)),
       depth_(depth == 0 ? 1 : depth),
@@ -18,9 +20,9 @@ BackgroundSink::BackgroundSink(std::unique_ptr<FrameSink> sink, std::size_t dept
 BackgroundSink::~BackgroundSink()
 {
     try {
-        finish();
+        abandon(false);
     } catch (...) {
-        // The caller that wanted the error called finish() itself.
+        // A sink that was not finished is a failed run's, whose error the caller has.
     }
 }
 
@@ -86,31 +88,48 @@ void BackgroundSink::writeFrame(const cv::Mat& image, const Frame& origin)
     enqueue({image, origin});
 }
 
-void BackgroundSink::finish()
+bool BackgroundSink::stop(bool drop)
 {
     std::unique_lock lock(mutex_);
-    if (finished_) {
+    if (finished_)
+        return false;
+    finished_ = true;
+    stopping_ = true;
+    if (drop)
+        jobs_.clear();
+    lock.unlock();
+    changed_.notify_all();
+    thread_.join(); // every queued frame written (or skipped after a failed one)
+    return true;
+}
+
+fs::path BackgroundSink::abandon(bool keep)
+{
+    stop(!keep);
+    if (std::exchange(closed_, true))
+        return {};
+    fs::path kept = sink_->abandon(keep);
+    const std::lock_guard lock(mutex_);
+    describe_ = sink_->describe();
+    return kept;
+}
+
+void BackgroundSink::finish()
+{
+    stop(false);
+    std::unique_lock lock(mutex_);
+    // A failed write: the output is a failed run's, not finalised here; the caller abandons it
+    // (as it would a sink written on its own thread), and gets the write's error, the first.
+    if (closed_ || failedFrame_) {
         if (error_)
             std::rethrow_exception(std::exchange(error_, nullptr));
         return;
     }
-    finished_ = true;
-    stopping_ = true;
     lock.unlock();
-    changed_.notify_all();
-    thread_.join(); // every queued frame written (or skipped after a failed one)
-    // Finalised even after a failed write, as a sink written on the caller's thread would be by
-    // the caller's finish(); the write's error, the first, is the one rethrown.
-    std::exception_ptr finishError;
-    try {
-        sink_->finish();
-    } catch (...) {
-        finishError = std::current_exception();
-    }
+    closed_ = true;
+    sink_->finish();
     lock.lock();
     describe_ = sink_->describe();
-    if (std::exception_ptr error = error_ ? std::exchange(error_, nullptr) : finishError)
-        std::rethrow_exception(error);
 }
 
 std::size_t BackgroundSink::framesWritten() const

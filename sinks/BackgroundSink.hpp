@@ -23,7 +23,7 @@ public:
     /// Writes to `sink` (a file output; not a window or a virtual camera, whose frames are due
     /// when they are made) on its own thread, at most `depth` frames behind writeFrame() (>= 1).
     explicit BackgroundSink(std::unique_ptr<FrameSink> sink, std::size_t depth = 2);
-    /// finish(), errors swallowed: call finish() to see them.
+    /// Without finish(), abandon(false), errors swallowed.
     ~BackgroundSink() override;
     BackgroundSink(const BackgroundSink&) = delete;
     BackgroundSink& operator=(const BackgroundSink&) = delete;
@@ -33,9 +33,12 @@ public:
     /// write that failed since the last call; once one has failed, nothing more is written.
     void write(const cv::Mat& image) override;
     void writeFrame(const cv::Mat& image, const Frame& origin) override;
-    /// Writes what is queued, then finalises the output. Rethrows the first error of a write
-    /// (not yet rethrown) or of finalising.
+    /// Writes what is queued, then finalises the output. After a failed write it rethrows that
+    /// write's error (if not rethrown yet) and leaves the output to abandon(), unfinished.
     void finish() override;
+    /// Writes what is queued (with `keep`; else drops it), then abandons the output. Rethrows an
+    /// error of abandoning, not a write's (the caller that abandons has one of its own).
+    std::filesystem::path abandon(bool keep) override;
     /// Frames written (not queued) so far.
     std::size_t framesWritten() const override;
     /// The output's description, as of the last frame written.
@@ -50,6 +53,8 @@ private:
     };
     void enqueue(Job job);
     void run();
+    /// Stops the thread once what is queued is written (`drop`: skipped); false if already done.
+    bool stop(bool drop);
 
     std::unique_ptr<FrameSink> sink_;
     const std::size_t depth_;
@@ -62,7 +67,8 @@ private:
     std::exception_ptr error_; // the failed write's, until rethrown
     std::optional<std::size_t> failedFrame_;
     bool stopping_ = false;
-    bool finished_ = false;
+    bool finished_ = false; // the thread is stopped (or stopping)
+    bool closed_ = false;   // sink_ finished or abandoned; the caller's thread only
     std::thread thread_; // last: starts once everything above is made
 };
 

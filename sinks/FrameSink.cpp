@@ -45,6 +45,30 @@ void requireParentFolder(const fs::path& output, bool isFolder)
     throw SinkError(fmt::format("cannot write '{}': folder '{}' does not exist", output.string(), parent.string()));
 }
 
+namespace {
+
+/// `output` without a trailing '/': "out/" -> "out".
+fs::path withoutSlash(const fs::path& output)
+{
+    return output.has_filename() ? output : output.parent_path();
+}
+
+} // namespace
+
+fs::path partialPath(const fs::path& output, bool folder)
+{
+    const fs::path path = withoutSlash(output);
+    if (folder)
+        return path.parent_path() / (path.filename().string() + ".partial");
+    return path.parent_path() / (path.stem().string() + ".partial" + path.extension().string());
+}
+
+fs::path temporaryPath(const fs::path& output, bool folder)
+{
+    const fs::path partial = partialPath(output, folder);
+    return partial.parent_path() / fmt::format(".{}", partial.filename().string());
+}
+
 void writeFileAtomically(const fs::path& file, const std::string& contents)
 {
     const fs::path partial =

@@ -6,8 +6,12 @@
 //                  frames); -o out.exr the same, linear float
 //   -o /dev/video10  a virtual camera (v4l2loopback), YUYV
 // An output that exists is refused (SinkError) unless SinkOptions::overwrite, and so is one whose
-// folder is missing (a folder output's own last folder is made); every file is written under a
-// temporary name in its folder and renamed when complete.
+// folder is missing (a folder output's own last folder is made). A file output is
+// written under a hidden temporary name beside its final one (.NAME.partial.EXT; a folder's into
+// .NAME.partial/, or NAME/.defocus.partial/ when the folder exists) and put in place by finish()
+// only: a run that fails or is stopped calls abandon() instead, so nothing of it stands under the
+// final name and an earlier output there stays; abandon(true) keeps what was written under
+// NAME.partial.EXT (NAME.partial/).
 #pragma once
 
 #include <filesystem>
@@ -47,8 +51,21 @@ public:
         (void)origin;
         write(image);
     }
-    /// Finalises the output (closes the video container). Idempotent; also run by the destructor.
+    /// The run is done: finalises the output (closes the video container, writes a folder's
+    /// lists) and puts it under its final name. Idempotent.
     virtual void finish() = 0;
+    /// The run failed or was stopped: nothing is put under the final name (whatever stood there
+    /// before stays). What was written is removed, or with `keep` finalised under
+    /// partialPath(output), which is returned (empty when nothing was kept: no frame written, or
+    /// not `keep`). Then finish() and abandon() do nothing. A file sink destroyed without
+    /// finish() abandons its output. This default, for outputs without a name (a window, a
+    /// virtual camera), is finish().
+    virtual std::filesystem::path abandon(bool keep)
+    {
+        (void)keep;
+        finish();
+        return {};
+    }
     /// Frames written so far.
     virtual std::size_t framesWritten() const = 0;
     /// One line for logs, e.g. "video 'out.mp4' (mp4v, 30 fps, 120 frames)".
@@ -91,6 +108,13 @@ void refuseExisting(const std::filesystem::path& file, bool overwrite);
 /// goes into is missing. A folder output (`isFolder`) may be missing itself, as its sink makes that
 /// last folder; never a whole path, which a typo would create.
 void requireParentFolder(const std::filesystem::path& output, bool isFolder);
+/// Where abandon(true) keeps an unfinished output: out.mp4 -> out.partial.mp4; a `folder` output
+/// out/ (or out) -> out.partial.
+std::filesystem::path partialPath(const std::filesystem::path& output, bool folder = false);
+/// The hidden temporary name a file sink writes `output` under until finish() renames it:
+/// out.mp4 -> .out.partial.mp4, a folder out/ -> .out.partial (in the same folder as the final
+/// name, so that the rename is atomic).
+std::filesystem::path temporaryPath(const std::filesystem::path& output, bool folder = false);
 
 /// Writes `contents` to `file` under a temporary name in the same folder and renames it into
 /// place, so no reader ever sees a half-written file. Throws SinkError naming the file.

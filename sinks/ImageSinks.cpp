@@ -1,5 +1,5 @@
-// Image sinks: numbered PNG/EXR sequences and single image files, each file written under a
-// temporary name and renamed into place.
+// Image sinks: numbered PNG/EXR sequences and single image files, written under a hidden
+// temporary name and renamed into place when the run is done.
 #include "sinks/ImageSinks.hpp"
 
 #include <algorithm>
@@ -142,17 +142,20 @@ cv::Mat tumDepth(const cv::Mat& metres)
 } // namespace
 
 ImageSequenceSink::ImageSequenceSink(fs::path folder, bool linear, double fps)
-    : folder_(std::move(folder)), linear_(linear), fps_(fps > 0.0 ? fps : 30.0)
+    : folder_(folder.has_filename() ? std::move(folder) : folder.parent_path()), linear_(linear), fps_(fps > 0.0 ? fps : 30.0)
 {
+    // Beside a new folder, so that one rename puts it in place; inside one that exists (it may be
+    // a mount point, or the current folder), so that its files can be moved in.
     std::error_code ec;
-    createdFolder_ = !fs::exists(folder_, ec);
-    prepareFolder(folder_, folder_);
+    work_ = fs::is_directory(folder_, ec) ? folder_ / ".defocus.partial" : temporaryPath(folder_, true);
+    fs::remove_all(work_, ec); // what a killed run left under this output's temporary name
+    prepareFolder(work_, folder_);
 }
 
 ImageSequenceSink::~ImageSequenceSink()
 {
     try {
-        finish();
+        abandon(false);
     } catch (const std::exception& e) {
         spdlog::error("{}", e.what());
     }
@@ -161,11 +164,6 @@ ImageSequenceSink::~ImageSequenceSink()
 SinkEncoding ImageSequenceSink::encoding() const
 {
     return linear_ ? SinkEncoding::Linear32F : SinkEncoding::Srgb8;
-}
-
-fs::path ImageSequenceSink::framePath(std::size_t index) const
-{
-    return index < entries_.size() ? folder_ / entries_[index].color : fs::path();
 }
 
 std::string ImageSequenceSink::nameFor(const Frame& origin)
@@ -192,17 +190,42 @@ void ImageSequenceSink::writeFrame(const cv::Mat& image, const Frame& origin)
     const std::string stem = nameFor(origin);
     Entry entry{origin.timestamp > 0.0 ? origin.timestamp : static_cast<double>(written_) / fps_,
                 stem + (linear_ ? ".exr" : ".png"), {}};
-    const fs::path file = folder_ / entry.color;
-    checkFrame(image, encoding(), file);
+    const fs::path file = work_ / entry.color;
+    checkFrame(image, encoding(), folder_ / entry.color);
     if (!origin.depth.empty() && origin.depth.type() == CV_32FC1) {
         entry.depth = "depth/" + stem + ".png";
         std::error_code ec;
-        fs::create_directories(folder_ / "depth", ec);
-        writeImageAtomically(folder_ / entry.depth, tumDepth(origin.depth));
+        fs::create_directories(work_ / "depth", ec);
+        writeImageAtomically(work_ / entry.depth, tumDepth(origin.depth));
     }
     writeImageAtomically(file, image);
     entries_.push_back(entry);
     ++written_;
+}
+
+void ImageSequenceSink::writeLists() const
+{
+    const auto list = [&](const char* what, auto line) {
+        std::string text = fmt::format("# {}\n# file: written by defocus\n# timestamp {}\n", what,
+                                       std::string(what) == "associations" ? "rgb timestamp depth" : "filename");
+        for (const Entry& e : entries_)
+            if (const std::string l = line(e); !l.empty())
+                text += l + "\n";
+        return text;
+    };
+    writeFileAtomically(work_ / "rgb.txt",
+                        list("color images", [](const Entry& e) { return fmt::format("{:.6f} {}", e.timestamp, e.color); }));
+    const bool anyDepth = std::any_of(entries_.begin(), entries_.end(), [](const Entry& e) { return !e.depth.empty(); });
+    if (!anyDepth)
+        return;
+    writeFileAtomically(work_ / "depth.txt", list("depth maps", [](const Entry& e) {
+                            return e.depth.empty() ? std::string() : fmt::format("{:.6f} {}", e.timestamp, e.depth);
+                        }));
+    writeFileAtomically(work_ / "associations.txt", list("associations", [](const Entry& e) {
+                            return e.depth.empty() ? std::string()
+                                                   : fmt::format("{:.6f} {} {:.6f} {}", e.timestamp, e.color,
+                                                                 e.timestamp, e.depth);
+                        }));
 }
 
 void ImageSequenceSink::finish()
@@ -212,32 +235,59 @@ void ImageSequenceSink::finish()
     finished_ = true;
     std::error_code ec;
     if (written_ == 0) {
-        if (createdFolder_ && fs::is_empty(folder_, ec) && fs::remove(folder_, ec))
-            spdlog::warn("sequence '{}': no frames written, so the folder it created is removed",
-                         folder_.string());
+        fs::remove_all(work_, ec);
+        spdlog::warn("sequence '{}': no frames written, so nothing written there", folder_.string());
         return;
     }
-    const auto list = [&](const char* what, auto line) {
-        std::string text = fmt::format("# {}\n# file: written by defocus\n# timestamp {}\n", what,
-                                       std::string(what) == "associations" ? "rgb timestamp depth" : "filename");
-        for (const Entry& e : entries_)
-            if (const std::string l = line(e); !l.empty())
-                text += l + "\n";
-        return text;
+    writeLists();
+    const auto failed = [&](const fs::path& what) {
+        return SinkError(fmt::format("cannot write sequence '{}': moving '{}' into place failed: {}", folder_.string(),
+                                     what.string(), ec.message()));
     };
-    writeFileAtomically(folder_ / "rgb.txt",
-                        list("color images", [](const Entry& e) { return fmt::format("{:.6f} {}", e.timestamp, e.color); }));
-    const bool anyDepth = std::any_of(entries_.begin(), entries_.end(), [](const Entry& e) { return !e.depth.empty(); });
-    if (!anyDepth)
+    // A new folder: one rename.
+    if (!fs::exists(folder_, ec)) {
+        fs::rename(work_, folder_, ec);
+        if (ec)
+            throw failed(work_);
         return;
-    writeFileAtomically(folder_ / "depth.txt", list("depth maps", [](const Entry& e) {
-                            return e.depth.empty() ? std::string() : fmt::format("{:.6f} {}", e.timestamp, e.depth);
-                        }));
-    writeFileAtomically(folder_ / "associations.txt", list("associations", [](const Entry& e) {
-                            return e.depth.empty() ? std::string()
-                                                   : fmt::format("{:.6f} {} {:.6f} {}", e.timestamp, e.color,
-                                                                 e.timestamp, e.depth);
-                        }));
+    }
+    // A folder that exists (empty, or holding files with -y): the frames and depth maps, then the
+    // lists, each renamed over the file of the same name; the folder's other files stay.
+    std::vector<std::string> names;
+    for (const Entry& e : entries_) {
+        if (!e.depth.empty())
+            names.push_back(e.depth);
+        names.push_back(e.color);
+    }
+    for (const char* list : {"depth.txt", "associations.txt", "rgb.txt"})
+        if (fs::exists(work_ / list, ec))
+            names.emplace_back(list);
+    for (const std::string& name : names) {
+        fs::create_directories((folder_ / name).parent_path(), ec);
+        fs::rename(work_ / name, folder_ / name, ec);
+        if (ec)
+            throw failed(work_ / name);
+    }
+    fs::remove_all(work_, ec);
+}
+
+fs::path ImageSequenceSink::abandon(bool keep)
+{
+    if (finished_)
+        return {};
+    finished_ = true;
+    std::error_code ec;
+    if (!keep || written_ == 0) {
+        fs::remove_all(work_, ec);
+        return {};
+    }
+    writeLists();
+    const fs::path kept = partialPath(folder_, true);
+    fs::remove_all(kept, ec); // an earlier run's
+    fs::rename(work_, kept, ec);
+    if (ec)
+        throw SinkError(fmt::format("cannot keep the partial sequence '{}': {}", kept.string(), ec.message()));
+    return kept;
 }
 
 std::string ImageSequenceSink::describe() const
@@ -257,13 +307,55 @@ SingleImageSink::SingleImageSink(fs::path file) : file_(std::move(file))
                                     ".png, .jpg or .exr)",
                                     file_.string(), ext));
     prepareFolder(file_.parent_path(), file_);
+    work_ = temporaryPath(file_);
+}
+
+SingleImageSink::~SingleImageSink()
+{
+    try {
+        abandon(false);
+    } catch (const std::exception& e) {
+        spdlog::error("{}", e.what());
+    }
 }
 
 void SingleImageSink::write(const cv::Mat& image)
 {
+    if (finished_)
+        throw SinkError(fmt::format("cannot write image '{}': already finished", file_.string()));
     checkFrame(image, encoding_, file_);
-    writeImageAtomically(file_, image);
+    writeImageAtomically(work_, image);
     ++written_;
+}
+
+void SingleImageSink::finish()
+{
+    if (finished_)
+        return;
+    finished_ = true;
+    if (written_ == 0)
+        return;
+    std::error_code ec;
+    fs::rename(work_, file_, ec);
+    if (ec)
+        throw SinkError(fmt::format("cannot write '{}': {}", file_.string(), ec.message()));
+}
+
+fs::path SingleImageSink::abandon(bool keep)
+{
+    if (finished_)
+        return {};
+    finished_ = true;
+    std::error_code ec;
+    if (!keep || written_ == 0) {
+        fs::remove(work_, ec);
+        return {};
+    }
+    const fs::path kept = partialPath(file_);
+    fs::rename(work_, kept, ec);
+    if (ec)
+        throw SinkError(fmt::format("cannot keep the partial image '{}': {}", kept.string(), ec.message()));
+    return kept;
 }
 
 std::string SingleImageSink::describe() const

@@ -1,5 +1,5 @@
-// Video sink: chooses a FourCC per container with fallbacks, writes to a partial file and renames
-// it into place when finished.
+// Video sink: chooses a FourCC per container with fallbacks, writes to a hidden temporary file and
+// renames it into place when finished.
 #include "sinks/VideoSink.hpp"
 
 #include <algorithm>
@@ -155,7 +155,7 @@ VideoSink::VideoSink(fs::path file, double fps, const std::string& codec) : file
         throw SinkError(fmt::format("cannot write video '{}': the frame rate must be positive, "
                                     "got {}",
                                     file_.string(), fps_));
-    partial_ = file_.parent_path() / (file_.stem().string() + ".partial" + file_.extension().string());
+    partial_ = temporaryPath(file_);
 
     std::error_code ec;
     const fs::path dir = file_.parent_path().empty() ? fs::path(".") : file_.parent_path();
@@ -191,7 +191,7 @@ VideoSink::VideoSink(fs::path file, double fps, const std::string& codec) : file
 VideoSink::~VideoSink()
 {
     try {
-        finish();
+        abandon(false);
     } catch (const std::exception& e) {
         spdlog::error("{}", e.what());
     }
@@ -255,9 +255,33 @@ void VideoSink::finish()
         return;
     }
     fs::rename(partial_, file_, ec);
-    if (ec)
-        throw SinkError(fmt::format("cannot write video '{}': renaming '{}' failed: {}",
-                                    file_.string(), partial_.string(), ec.message()));
+    if (ec) {
+        const std::string why = ec.message();
+        fs::remove(partial_, ec);
+        throw SinkError(fmt::format("cannot write video '{}': renaming '{}' failed: {}", file_.string(),
+                                    partial_.string(), why));
+    }
+}
+
+fs::path VideoSink::abandon(bool keep)
+{
+    if (finished_)
+        return {};
+    finished_ = true;
+    writer_.release();
+    std::error_code ec;
+    if (!keep || written_ == 0) {
+        fs::remove(partial_, ec);
+        return {};
+    }
+    const fs::path kept = partialPath(file_);
+    fs::rename(partial_, kept, ec);
+    if (ec) {
+        const std::string why = ec.message();
+        fs::remove(partial_, ec);
+        throw SinkError(fmt::format("cannot keep the partial video '{}': {}", kept.string(), why));
+    }
+    return kept;
 }
 
 std::string VideoSink::describe() const

@@ -19,9 +19,10 @@ class VideoSink final : public FrameSink {
 public:
     /// Picks the codec (`codec` by name, or the container's default) and proves at once that it
     /// opens (a tiny probe file, deleted again), so that a missing encoder or an unwritable folder
-    /// fails before any frame is processed. Frames go to NAME.partial.EXT, renamed to `file` by
-    /// finish(). Throws SinkError naming the file and the codecs tried.
+    /// fails before any frame is processed. Frames go to .NAME.partial.EXT beside `file`, renamed
+    /// to `file` by finish(). Throws SinkError naming the file and the codecs tried.
     VideoSink(std::filesystem::path file, double fps, const std::string& codec = {});
+    /// Without finish(), abandons the file (abandon(false)).
     ~VideoSink() override;
     VideoSink(const VideoSink&) = delete;
     VideoSink& operator=(const VideoSink&) = delete;
@@ -29,10 +30,12 @@ public:
     SinkEncoding encoding() const override { return SinkEncoding::Srgb8; }
     /// The first frame fixes the size; a frame of another size throws SinkError.
     void write(const cv::Mat& image) override;
-    /// Closes the container and renames it into place. Also the path after a failure in the
-    /// middle of a clip: the frames written so far become a playable, shorter video. With no
-    /// frame written, the partial file is deleted and no file is created.
+    /// Closes the container and renames it into place. With no frame written, the temporary
+    /// file is deleted and no file is created.
     void finish() override;
+    /// Closes the container; deletes it, or with `keep` renames it to NAME.partial.EXT (a
+    /// playable, shorter video).
+    std::filesystem::path abandon(bool keep) override;
     std::size_t framesWritten() const override { return written_; }
     std::string describe() const override;
 

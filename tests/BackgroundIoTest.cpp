@@ -126,6 +126,12 @@ public:
         const std::lock_guard lock(mutex);
         ++finishes;
     }
+    std::filesystem::path abandon(bool keep) override
+    {
+        const std::lock_guard lock(mutex);
+        ++abandons;
+        return keep ? "kept" : "";
+    }
     std::size_t framesWritten() const override { return values.size(); }
     std::string describe() const override { return "recording sink"; }
 
@@ -134,6 +140,7 @@ public:
     bool hold = false;
     std::vector<int> values;
     int finishes = 0;
+    int abandons = 0;
 
 private:
     std::optional<std::size_t> failAt_;
@@ -191,7 +198,8 @@ TEST(BackgroundSink, WritesEveryFrameInOrderBeforeFinishReturns)
 }
 
 // A write that fails reaches the caller (from a later writeFrame() or from finish()), names its
-// frame, stops the writes after it and still finalises the output.
+// frame and stops the writes after it. Defect caught as well: the output of a failed write
+// finalised by finish() (under its final name, a shorter clip) instead of left to abandon().
 TEST(BackgroundSink, AFailedWriteReachesTheCallerAndStopsTheWrites)
 {
     auto recording = std::make_unique<RecordingSink>(2);
@@ -219,7 +227,12 @@ TEST(BackgroundSink, AFailedWriteReachesTheCallerAndStopsTheWrites)
     EXPECT_EQ(inner.values, (std::vector<int>{0, 1}));
     EXPECT_EQ(sink.failedFrame(), 2u);
     EXPECT_EQ(sink.framesWritten(), 2u);
-    EXPECT_EQ(inner.finishes, 1);
+    EXPECT_EQ(inner.finishes, 0);
+    EXPECT_EQ(sink.abandon(true), std::filesystem::path("kept"));
+    EXPECT_EQ(inner.abandons, 1);
+    sink.abandon(false); // once only
+    EXPECT_EQ(inner.abandons, 1);
+    EXPECT_EQ(inner.finishes, 0);
 }
 
 // A slow output holds the caller back once `depth` frames wait (frames are not queued without

@@ -1,7 +1,7 @@
-// Bad input and a failure in the middle of a clip, through the defocus binary: the
-// message names the frame's file, the exit status is 1, and the frames before it are kept as
-// complete files (a shorter but playable video, or the sequence's first frames), with no
-// temporary file left. Needs an EGL context to render the frames before the failure.
+// Bad input and a failure in the middle of a clip, through the defocus binary: the message names
+// the frame's file, the exit status is 1, nothing is written under the output's name (an earlier
+// output there stays) and no temporary file is left; with --keep-partial the frames before it are
+// kept as OUTPUT.partial. Needs an EGL context to render the frames before the failure.
 #include <algorithm>
 #include <fstream>
 #include <iterator>
@@ -56,42 +56,92 @@ fs::path makeClipWithBrokenFrame(const std::string& name)
 
 using BadInputCliGLTest = test::GLTest;
 
-TEST_F(BadInputCliGLTest, BrokenFrameMidClipKeepsThePlayableVideoBeforeIt)
+// A copy of the bundled TUM clip (10 frames, 640x480) whose frame 5 colour file is cut in half;
+// returns the folder and sets `broken` to that file.
+fs::path tumClipWithBrokenFrame5(const std::string& name, fs::path& broken)
 {
-    const fs::path dir = makeClipWithBrokenFrame("CliGL_midclip_video");
-    const fs::path video = dir / "out" / "clip.avi";
-    fs::create_directory(dir / "out"); // defocus makes no missing folder above a file output
-    const CliResult r = runDefocus(fmt::format("'{}' --depth '{}' --focus 1 -o '{}'", (dir / "rgb").string(),
-                                               (dir / "depth").string(), video.string()));
-    EXPECT_EQ(r.exitCode, 1) << r.output;
-    EXPECT_NE(r.output.find("cannot read colour image '" + (dir / "rgb" / "3.png").string() + "': truncated PNG"),
-              std::string::npos)
-        << r.output;
-    EXPECT_NE(r.output.find("frame 3: cannot read colour image"), std::string::npos) << r.output;
-    EXPECT_NE(r.output.find("3 frames in, 3 frames out"), std::string::npos) << r.output;
-    EXPECT_EQ(fileNames(dir / "out"), std::vector<std::string>{"clip.avi"}) << r.output; // no clip.partial.avi
-
-    cv::VideoCapture capture(video.string());
-    ASSERT_TRUE(capture.isOpened()) << r.output;
-    int frames = 0;
-    for (cv::Mat frame; capture.read(frame); ++frames)
-        EXPECT_EQ(frame.size(), cv::Size(64, 48));
-    EXPECT_EQ(frames, 3);
+    const fs::path dir = test::scratchDir(name) / "clip";
+    fs::copy(test::dataDir() / "tum_fr1_rpy", dir, fs::copy_options::recursive);
+    std::ifstream list(dir / "associations.txt");
+    std::vector<std::string> colour;
+    for (std::string line; std::getline(list, line);)
+        if (!line.empty() && line[0] != '#')
+            colour.push_back(line.substr(line.find(' ') + 1, line.find(' ', line.find(' ') + 1) - line.find(' ') - 1));
+    EXPECT_EQ(colour.size(), 10u);
+    broken = dir / colour.at(5);
+    std::ifstream in(broken, std::ios::binary);
+    const std::vector<char> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    in.close();
+    std::ofstream(broken, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
+    return dir;
 }
 
-TEST_F(BadInputCliGLTest, BrokenFrameMidClipKeepsTheSequenceBeforeIt)
+std::string contents(const fs::path& file)
 {
-    const fs::path dir = makeClipWithBrokenFrame("CliGL_midclip_sequence");
-    const CliResult r = runDefocus(fmt::format("'{}' --depth '{}' --focus 1 -o '{}/'", (dir / "rgb").string(),
-                                               (dir / "depth").string(), (dir / "out").string()));
-    EXPECT_EQ(r.exitCode, 1) << r.output;
-    EXPECT_NE(r.output.find((dir / "rgb" / "3.png").string()), std::string::npos) << r.output;
-    // The input's frame names, listed: the sequence is a TUM folder of the frames before the bad one.
-    EXPECT_EQ(fileNames(dir / "out"), (std::vector<std::string>{"0.png", "1.png", "2.png", "associations.txt", "depth",
-                                                               "depth.txt", "rgb.txt"}))
-        << r.output;
-    for (int k = 0; k < 3; ++k)
-        EXPECT_EQ(cv::imread((dir / "out" / fmt::format("{}.png", k)).string()).size(), cv::Size(64, 48));
+    std::ifstream in(file, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Defect caught: a clip that fails at a corrupt frame leaves its first frames under the output's
+// final name (a shorter video, a folder listing 5 of 10 frames, frame 4 as the image), where they
+// look like a finished result, and with -y in place of a good earlier output; or a temporary
+// file or folder left beside it. Each output kind: the error names the frame's file, exit 1, the
+// earlier output untouched, nothing else in its folder.
+TEST_F(BadInputCliGLTest, BrokenFrameMidClipLeavesTheEarlierOutputUntouched)
+{
+    fs::path broken;
+    const fs::path clip = tumClipWithBrokenFrame5("CliGL_midclip_untouched", broken);
+    const fs::path out = clip.parent_path() / "out";
+    fs::create_directories(out / "tb");
+    std::ofstream(out / "tb.mp4") << "an earlier good video";
+    std::ofstream(out / "tb.png") << "an earlier good image";
+    std::ofstream(out / "tb" / "rgb.txt") << "# an earlier good sequence\n1.0 1.png\n";
+    std::ofstream(out / "tb" / "1.png") << "an earlier good frame";
+    for (const std::string output : {"tb.mp4", "tb/", "tb.png"}) {
+        const CliResult r = runDefocus(fmt::format("'{}' --focus 1 --quality fast -y -o '{}'", clip.string(),
+                                                   (out / output).string()));
+        EXPECT_EQ(r.exitCode, 1) << output << "\n" << r.output;
+        EXPECT_NE(r.output.find("frame 5: cannot read colour image '" + broken.string()), std::string::npos)
+            << r.output;
+        EXPECT_EQ(fileNames(out), (std::vector<std::string>{"tb", "tb.mp4", "tb.png"})) << output;
+        EXPECT_EQ(fileNames(out / "tb"), (std::vector<std::string>{"1.png", "rgb.txt"})) << output;
+    }
+    EXPECT_EQ(contents(out / "tb.mp4"), "an earlier good video");
+    EXPECT_EQ(contents(out / "tb.png"), "an earlier good image");
+    EXPECT_EQ(contents(out / "tb" / "rgb.txt"), "# an earlier good sequence\n1.0 1.png\n");
+}
+
+// Defect caught: --keep-partial losing the frames before the failure, keeping them under the
+// final name, or keeping a video that does not play them all.
+TEST_F(BadInputCliGLTest, BrokenFrameMidClipWithKeepPartialKeepsTheFramesBeforeIt)
+{
+    fs::path broken;
+    const fs::path clip = tumClipWithBrokenFrame5("CliGL_midclip_keep", broken);
+    const fs::path out = clip.parent_path() / "out";
+    fs::create_directories(out); // defocus makes no missing folder above a file output
+    for (const std::string output : {"tb.mp4", "tb/", "tb.png"}) {
+        const CliResult r = runDefocus(fmt::format("'{}' --focus 1 --quality fast --keep-partial -o '{}'",
+                                                   clip.string(), (out / output).string()));
+        EXPECT_EQ(r.exitCode, 1) << output << "\n" << r.output;
+        EXPECT_NE(r.output.find("5 frames in, 5 frames out"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("the frames before the error are in"), std::string::npos) << r.output;
+    }
+    EXPECT_EQ(fileNames(out), (std::vector<std::string>{"tb.partial", "tb.partial.mp4", "tb.partial.png"}));
+    cv::VideoCapture capture((out / "tb.partial.mp4").string());
+    ASSERT_TRUE(capture.isOpened());
+    int frames = 0;
+    for (cv::Mat frame; capture.read(frame); ++frames)
+        EXPECT_EQ(frame.size(), cv::Size(640, 480));
+    EXPECT_EQ(frames, 5);
+    std::ifstream list(out / "tb.partial" / "rgb.txt");
+    int listed = 0;
+    for (std::string line; std::getline(list, line);)
+        if (!line.empty() && line[0] != '#') {
+            ++listed;
+            EXPECT_TRUE(fs::exists(out / "tb.partial" / line.substr(line.find(' ') + 1))) << line;
+        }
+    EXPECT_EQ(listed, 5);
+    EXPECT_EQ(cv::imread((out / "tb.partial.png").string()).size(), cv::Size(640, 480));
 }
 
 TEST_F(BadInputCliGLTest, BrokenFirstFrameLeavesNoOutputAtAll)

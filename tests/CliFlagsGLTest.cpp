@@ -894,6 +894,7 @@ TEST_F(CliFlags, EveryOptionInTheHelpHasATest)
         {"--focus-point", "CliFlags.FocusPointMeasuresTheFocusThere"},
         {"--tau", "CliFlags.TauDampsTheTrackedFocus"},
         {"--overwrite", "exit-status-test.sh (existing output with and without -y)"},
+        {"--keep-partial", "BadInputGLTest.BrokenFrameMidClipWithKeepPartialKeepsTheFramesBeforeIt; CliGLTest Interrupt"},
         {"--codec", "CliFlags.CodecAndImageFormatChooseWhatIsWritten"},
         {"--image-format", "CliFlags.CodecAndImageFormatChooseWhatIsWritten"},
         {"--fps", "CliFlags.FpsSetsTheVideosRate"},

@@ -1,5 +1,5 @@
-// The defocus program end to end: Ctrl-C (SIGINT) and SIGTERM finalise what was written, every
-// input frame gives an output frame, frames and focus chosen over time, and the depth-scale warning.
+// The defocus program end to end: Ctrl-C (SIGINT) and SIGTERM leave nothing under the output's
+// name (--keep-partial keeps the frames so far beside it), every input frame gives an output frame, frames and focus chosen over time, and the depth-scale warning.
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -106,31 +106,47 @@ long framesOut(const std::string& output)
 
 class Interrupt : public Cli, public ::testing::WithParamInterface<int> {};
 
-TEST_P(Interrupt, VideoWrittenSoFarIsFinalisedAndPlayable)
+// Defect caught: a clip stopped by Ctrl-C or SIGTERM left under the output's final name (a shorter
+// video that looks finished), a wrong exit status, or --keep-partial losing frames that were counted
+// as written (every one of them must play back from OUTPUT.partial.mp4).
+TEST_P(Interrupt, StoppedClipIsKeptOnlyAsPartialWhenAsked)
 {
     // Own folders per signal: CTest runs the two instances in parallel.
     const std::string suffix = std::to_string(GetParam());
     const fs::path clip = longClip("interrupt_clip_" + suffix, 200);
-    const fs::path out = test::scratchDir("interrupt_out_" + suffix) / "clip.mp4";
-    const fs::path partial = out.parent_path() / "clip.partial.mp4";
-    // Signal once a few frames are in the container.
-    const ProgramRun run = runDefocus({(clip / "rgb").string(), "--depth", (clip / "depth").string(), "--depth-scale", "5000", "-o",
-                                out.string(), "--focus", "1"},
-                               GetParam(), [&] { return fs::exists(partial) && fs::file_size(partial) > 20000; },
-                               out.parent_path() / "log.txt");
-    EXPECT_EQ(run.exitCode, GetParam() == SIGINT ? 130 : 143) << run.output; // 128 + the signal, as shells report it
-    ASSERT_TRUE(fs::exists(out)) << run.output;
-    EXPECT_FALSE(fs::exists(partial));
-    const long written = framesOut(run.output);
-    EXPECT_GT(written, 0) << run.output;
-    EXPECT_LT(written, 200) << "the signal came before the end";
-    cv::VideoCapture video(out.string());
-    ASSERT_TRUE(video.isOpened());
-    long decoded = 0;
-    cv::Mat frame;
-    while (video.read(frame))
-        ++decoded;
-    EXPECT_EQ(decoded, written) << "every frame counted as written must play back";
+    const fs::path dir = test::scratchDir("interrupt_out_" + suffix);
+    for (const bool keep : {false, true}) {
+        const fs::path out = dir / (keep ? "kept.mp4" : "clip.mp4");
+        const fs::path temporary = dir / (keep ? ".kept.partial.mp4" : ".clip.partial.mp4");
+        const fs::path partial = dir / (keep ? "kept.partial.mp4" : "clip.partial.mp4");
+        std::vector<std::string> args{(clip / "rgb").string(), "--depth", (clip / "depth").string(), "--depth-scale",
+                                      "5000", "-o", out.string(), "--focus", "1"};
+        if (keep)
+            args.push_back("--keep-partial");
+        // Signal once a few frames are in the container.
+        const ProgramRun run = runDefocus(
+            args, GetParam(), [&] { return fs::exists(temporary) && fs::file_size(temporary) > 20000; },
+            dir / "log.txt");
+        EXPECT_EQ(run.exitCode, GetParam() == SIGINT ? 130 : 143) << run.output; // 128 + the signal, as shells report it
+        EXPECT_FALSE(fs::exists(out)) << run.output;
+        EXPECT_FALSE(fs::exists(temporary)) << run.output;
+        const long written = framesOut(run.output);
+        EXPECT_GT(written, 0) << run.output;
+        EXPECT_LT(written, 200) << "the signal came before the end";
+        if (!keep) {
+            EXPECT_FALSE(fs::exists(partial)) << run.output;
+            EXPECT_NE(run.output.find("nothing written to " + out.string()), std::string::npos) << run.output;
+            continue;
+        }
+        EXPECT_NE(run.output.find("the frames so far are in " + partial.string()), std::string::npos) << run.output;
+        cv::VideoCapture video(partial.string());
+        ASSERT_TRUE(video.isOpened()) << run.output;
+        long decoded = 0;
+        cv::Mat frame;
+        while (video.read(frame))
+            ++decoded;
+        EXPECT_EQ(decoded, written) << "every frame counted as written must play back";
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM),

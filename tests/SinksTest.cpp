@@ -7,6 +7,7 @@
 #include <limits>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -69,7 +70,8 @@ TEST(ImageSequenceSink, FramesWithoutInputNamesAreNumberedAndListed)
 {
     const fs::path dir = test::scratchDir("Sink_sequence") / "out";
     const std::unique_ptr<FrameSink> sink = openSink({dir.string() + "/", 30.0, false});
-    EXPECT_TRUE(fs::is_directory(dir)); // created at open
+    EXPECT_FALSE(fs::exists(dir)); // the frames go to a hidden folder beside it until finish()
+    EXPECT_TRUE(fs::is_directory(temporaryPath(dir, true)));
     EXPECT_EQ(sink->encoding(), SinkEncoding::Srgb8);
     for (int k = 0; k < 3; ++k)
         sink->write(testFrame(k));
@@ -92,7 +94,8 @@ TEST(ImageSequenceSink, ExistingFolderWithoutSlashAndLinearExrSequence)
     const cv::Mat hdr(8, 8, CV_32FC3, cv::Scalar(0.5, 4.0, 80.0));
     sink->write(hdr);
     sink->write(hdr * 2.0);
-    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"frame_000000.exr", "frame_000001.exr"}));
+    sink->finish();
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"frame_000000.exr", "frame_000001.exr", "rgb.txt"}));
     const cv::Mat back = readBack(dir / "frame_000001.exr");
     ASSERT_EQ(back.type(), CV_32FC3);
     EXPECT_EQ(back.at<cv::Vec3f>(7, 7), cv::Vec3f(1.0f, 8.0f, 160.0f));
@@ -265,6 +268,7 @@ TEST(VideoSink, EveryCodecDecodesEveryFrameAtItsQuality)
             const std::unique_ptr<FrameSink> sink = openSink(options);
             for (const cv::Mat& frame : clip)
                 sink->write(frame);
+            sink->finish();
         }
         cv::VideoCapture capture(file.string());
         ASSERT_TRUE(capture.isOpened()) << file;
@@ -314,20 +318,93 @@ TEST(VideoSink, FrameOfAnotherSizeIsASinkError)
     EXPECT_EQ(sink->framesWritten(), 1u);
 }
 
-TEST(VideoSink, DestructorFinishesTheFile)
+// Defect caught: a sink destroyed without finish() (an exception unwinding the run) putting a
+// shorter video under the output's name.
+TEST(VideoSink, DestructorWithoutFinishLeavesNoFile)
 {
-    const fs::path file = test::scratchDir("Sink_video_dtor") / "clip.avi";
+    const fs::path dir = test::scratchDir("Sink_video_dtor");
     {
-        const std::unique_ptr<FrameSink> sink = openSink({file, 30.0, false});
+        const std::unique_ptr<FrameSink> sink = openSink({dir / "clip.avi", 30.0, false});
         sink->write(testFrame(0));
         sink->write(testFrame(1));
     }
-    cv::VideoCapture capture(file.string());
-    ASSERT_TRUE(capture.isOpened());
-    int read = 0;
-    for (cv::Mat frame; capture.read(frame);)
-        ++read;
-    EXPECT_EQ(read, 2);
+    EXPECT_TRUE(fileNames(dir).empty());
+}
+
+std::string contents(const fs::path& file)
+{
+    std::ifstream in(file, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Defect caught: a failed or stopped run's frames put under the output's final name, or in place of
+// an earlier output there (-y), or a temporary file or folder left beside it; and abandon(true)
+// not keeping the frames written under NAME.partial. Each file output kind.
+TEST(FileSinks, AbandonLeavesTheFinalNameAloneAndKeepsThePartialOnlyWhenAsked)
+{
+    const fs::path dir = test::scratchDir("Sink_abandon");
+    std::ofstream(dir / "clip.avi") << "earlier video";
+    std::ofstream(dir / "one.png") << "earlier image";
+    fs::create_directories(dir / "seq");
+    std::ofstream(dir / "seq" / "rgb.txt") << "earlier list";
+    const std::vector<std::string> before{"clip.avi", "one.png", "seq"};
+    for (const std::string output : {"clip.avi", "seq/", "one.png"}) {
+        SinkOptions options{dir / output, 30.0, false};
+        options.overwrite = true;
+        {
+            const std::unique_ptr<FrameSink> sink = openSink(options);
+            sink->write(testFrame(0));
+            sink->write(testFrame(1));
+            EXPECT_TRUE(sink->abandon(false).empty()) << output;
+            sink->finish(); // does nothing now
+        }
+        EXPECT_EQ(fileNames(dir), before) << output;
+        const std::unique_ptr<FrameSink> sink = openSink(options);
+        sink->write(testFrame(0));
+        sink->write(testFrame(1));
+        const fs::path kept = sink->abandon(true);
+        EXPECT_EQ(kept, partialPath(dir / output, output == "seq/")) << output;
+        EXPECT_TRUE(fs::exists(kept)) << output;
+        fs::rename(kept, dir / "kept");
+        EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"clip.avi", "kept", "one.png", "seq"})) << output;
+        if (output == "clip.avi") {
+            cv::VideoCapture capture((dir / "kept").string(), cv::CAP_FFMPEG);
+            int read = 0;
+            for (cv::Mat frame; capture.read(frame);)
+                ++read;
+            EXPECT_EQ(read, 2);
+        } else if (output == "seq/") {
+            EXPECT_EQ(fileNames(dir / "kept"), (std::vector<std::string>{"frame_000000.png", "frame_000001.png",
+                                                                        "rgb.txt"}));
+        } else {
+            EXPECT_EQ(cv::norm(readBack(dir / "kept"), testFrame(1), cv::NORM_INF), 0.0);
+        }
+        fs::remove_all(dir / "kept");
+    }
+    EXPECT_EQ(contents(dir / "clip.avi"), "earlier video");
+    EXPECT_EQ(contents(dir / "one.png"), "earlier image");
+    EXPECT_EQ(fileNames(dir / "seq"), std::vector<std::string>{"rgb.txt"});
+    EXPECT_EQ(contents(dir / "seq" / "rgb.txt"), "earlier list");
+}
+
+// Defect caught: -y into a folder that holds other files deleting them, a finished sequence not
+// put in place over the earlier frames and lists, or the frames for a folder that exists written
+// beside it (its parent may be another file system, as for a mount point, or not writable).
+TEST(ImageSequenceSink, FinishIntoAFolderWithFilesReplacesItsFramesAndListsOnly)
+{
+    const fs::path dir = test::scratchDir("Sink_sequence_into");
+    std::ofstream(dir / "notes.md") << "mine";
+    std::ofstream(dir / "rgb.txt") << "earlier list";
+    SinkOptions options{dir, 30.0, false};
+    options.overwrite = true;
+    const std::unique_ptr<FrameSink> sink = openSink(options);
+    sink->write(testFrame(0));
+    EXPECT_FALSE(fs::exists(temporaryPath(dir, true)));
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{".defocus.partial", "notes.md", "rgb.txt"}));
+    sink->finish();
+    EXPECT_EQ(fileNames(dir), (std::vector<std::string>{"frame_000000.png", "notes.md", "rgb.txt"}));
+    EXPECT_NE(contents(dir / "rgb.txt").find("frame_000000.png"), std::string::npos);
+    EXPECT_FALSE(fs::exists(temporaryPath(dir, true)));
 }
 
 TEST(VideoSink, NoFramesLeavesNoFile)
@@ -362,10 +439,11 @@ TEST(SingleImageSink, ExrKeepsValuesAboveOneUnclipped)
     cv::Mat hdr(5, 7, CV_32FC3, cv::Scalar(0.001, 1.0, 80.0));
     hdr.at<cv::Vec3f>(2, 3) = cv::Vec3f(1234.5f, 0.0f, 3.25f);
     sink->write(hdr);
+    EXPECT_THROW(sink->write(cv::Mat(5, 7, CV_8UC3)), SinkError);
+    sink->finish();
     const cv::Mat back = readBack(file);
     ASSERT_EQ(back.type(), CV_32FC3);
     EXPECT_EQ(cv::norm(back, hdr, cv::NORM_INF), 0.0); // 32-bit float EXR is exact
-    EXPECT_THROW(sink->write(cv::Mat(5, 7, CV_8UC3)), SinkError);
 }
 
 TEST(OpenSink, UnknownOrMissingExtensionIsASinkError)
