@@ -4,7 +4,6 @@
 //   defocus-synthetic --scene edges --focal-length 85 --f-number 1.4 --focus 5 --samples 1024 -o out/edges
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -16,6 +15,7 @@
 #include "filter/gl/EglContext.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
+#include "sources/ImageIO.hpp"
 #include "sources/SyntheticScene.hpp"
 
 namespace {
@@ -93,7 +93,7 @@ int main(int argc, char** argv)
         fmt::print(stderr, "defocus-synthetic: --frame {} is not below --frames {}\n", frame, settings.frames);
         return kExitUsage;
     }
-    ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0); // before OpenCV's first EXR write; a user's value wins
+    enableOpenExr(); // before OpenCV's first EXR write
     try {
         auto context = gl::EglContext::create();
         SyntheticScene scene(syntheticScene(sceneName), settings);
