@@ -52,6 +52,11 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv)
     return std::nullopt;
 }
 
+void addVersionFlag(CLI::App& app, std::string_view program)
+{
+    app.set_version_flag("--version", fmt::format("{} {}", program, DEFOCUS_VERSION));
+}
+
 void printError(std::string_view program, std::string_view message)
 {
     std::fflush(stdout);
