@@ -4,7 +4,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <span>
 
 #include <opencv2/core.hpp>
@@ -12,6 +11,7 @@
 
 #include "fuzz/FuzzSupport.hpp"
 #include "sources/ImageHeader.hpp"
+#include "sources/ImageIO.hpp"
 
 namespace defocus::fuzz {
 
@@ -21,7 +21,7 @@ inline constexpr std::size_t kMaxPixels = std::size_t{1} << 20;
 
 inline void setUpOpenCv()
 {
-    ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 1);
+    enableOpenExr();
     cv::setNumThreads(0);
     cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
 }

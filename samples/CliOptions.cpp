@@ -76,6 +76,11 @@ std::string errorMessage(const CLI::ParseError& error)
     return text;
 }
 
+void addVersionFlag(CLI::App& app, std::string_view program)
+{
+    app.set_version_flag("--version", fmt::format("{} {}", program, DEFOCUS_VERSION));
+}
+
 void printError(std::string_view program, std::string_view message)
 {
     std::fflush(stdout);

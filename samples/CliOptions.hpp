@@ -29,6 +29,9 @@ namespace defocus::cli {
 /// "PROGRAM: error: MESSAGE (see --help)" to standard error and gives kExitUsage. nullopt: go on.
 std::optional<int> parse(CLI::App& app, int argc, char** argv);
 
+/// --version, which prints "PROGRAM VERSION": the project's version, CMake's PROJECT_VERSION.
+void addVersionFlag(CLI::App& app, std::string_view program);
+
 /// Sends every log line (spdlog's default logger) to standard error as "PROGRAM: LEVEL: ...";
 /// standard output keeps only results. quiet: warnings and errors only; verbose: debug too.
 void logToStderr(std::string_view program, bool quiet = false, bool verbose = false);

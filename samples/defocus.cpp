@@ -571,7 +571,7 @@ void declareOptions(CLI::App& app, Options& o)
     // Given twice, an option's last value counts: a manifest line's options come after the
     // command line's and win (--batch).
     app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
-    app.set_version_flag("--version", "defocus 0.1.0");
+    cli::addVersionFlag(app, "defocus");
     app.add_option("input", o.input, "Colour input: TUM folder, image folder or image file");
     app.add_option("-o,--output", o.output,
                    "Output: DIR/ (numbered PNGs), FILE.mp4|.mkv|.avi (video), FILE.png (one frame), FILE.exr "

@@ -630,7 +630,7 @@ int main(int argc, char** argv)
                  "scene. Run it from the repository root. The subcommands time the per-frame plan (plan), hold the "
                  "per-pass timing baseline (timing) and sweep accuracy against a path-traced lens (accuracy); "
                  "each has its own --help."};
-    app.set_version_flag("--version", "defocus-bench 0.1.0");
+    defocus::cli::addVersionFlag(app, "defocus-bench");
     app.require_subcommand(0, 1);
     defocus::TimingOptions timingOptions;
     CLI::App* timing = declareTiming(app, timingOptions);

@@ -329,7 +329,7 @@ int main(int argc, char** argv)
                  "images or one image; --depth gives its depth (a file, a folder, a TUM depth.txt or a Z16 camera "
                  "/dev/videoN).\nKeys: " +
                  std::string(kKeyHelp)};
-    app.set_version_flag("--version", "defocus-preview 0.1.0");
+    cli::addVersionFlag(app, "defocus-preview");
     app.add_option("input", o.input, "Colour input: /dev/videoN, video file, TUM folder, image folder or image")
         ->required();
     app.add_option("--depth", o.depth, "Depth for INPUT: one image (fixed camera), a folder, depth.txt, or /dev/videoN");

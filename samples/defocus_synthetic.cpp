@@ -4,7 +4,6 @@
 //   defocus-synthetic --scene edges --focal-length 85 --f-number 1.4 --focus 5 --samples 1024 -o out/edges
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -20,6 +19,7 @@
 #include "samples/ExitStatus.hpp"
 #include "sinks/FrameSink.hpp"
 #include "sinks/ImageSinks.hpp"
+#include "sources/ImageIO.hpp"
 #include "sources/SyntheticScene.hpp"
 
 namespace {
@@ -102,7 +102,7 @@ int main(int argc, char** argv)
         spdlog::error("--frame {} is not below --frames {}", frame, settings.frames);
         return kExitUsage;
     }
-    ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0); // before OpenCV's first EXR write; a user's value wins
+    enableOpenExr(); // before OpenCV's first EXR write
     try {
         // The output, as defocus's: its folder's parent exists, and no file is replaced without -y.
         requireParentFolder(fs::path(out) / "", true);

@@ -2,8 +2,6 @@
 // /dev/video* virtual camera).
 #include "sinks/FrameSink.hpp"
 
-#include <algorithm>
-#include <cctype>
 #include <fstream>
 #include <system_error>
 
@@ -14,6 +12,7 @@
 #include "sinks/ImageSinks.hpp"
 #include "sinks/V4l2OutputSink.hpp"
 #include "sinks/VideoSink.hpp"
+#include "sources/PathNames.hpp"
 
 namespace defocus {
 
@@ -107,9 +106,7 @@ std::unique_ptr<FrameSink> openSink(const SinkOptions& options)
     requireParentFolder(output, false);
     refuseExisting(output, options.overwrite);
 
-    std::string ext = output.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string ext = lowerExtension(output);
     if (ext == ".mp4" || ext == ".mkv" || ext == ".webm" || ext == ".avi")
         return std::make_unique<VideoSink>(output, options.fps, options.codec);
     if (!options.codec.empty())

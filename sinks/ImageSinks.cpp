@@ -3,10 +3,8 @@
 #include "sinks/ImageSinks.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <set>
 #include <fstream>
 #include <system_error>
@@ -19,31 +17,15 @@
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
+#include "sources/ImageIO.hpp"
+#include "sources/PathNames.hpp"
+
 namespace defocus {
 namespace {
 
 namespace fs = std::filesystem;
 
 constexpr int jpegQuality = 95;
-
-// OpenCV reads OPENCV_IO_ENABLE_OPENEXR when it first encodes or decodes an EXR file; a value
-// the user set (even "0") is left alone.
-void enableOpenExr()
-{
-    static const bool enabled = [] {
-        ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
-        return true;
-    }();
-    (void)enabled;
-}
-
-std::string lowerExtension(const fs::path& file)
-{
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
 
 int expectedType(SinkEncoding encoding)
 {

@@ -2,8 +2,6 @@
 // renames it into place when finished.
 #include "sinks/VideoSink.hpp"
 
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -20,6 +18,8 @@
 #include <opencv2/videoio/registry.hpp>
 #include <spdlog/spdlog.h>
 
+#include "sources/PathNames.hpp"
+
 namespace defocus {
 namespace {
 
@@ -27,14 +27,6 @@ namespace fs = std::filesystem;
 
 /// Size of the probe video written (and deleted) by the constructor.
 const cv::Size probeSize{64, 48};
-
-std::string lowerExtension(const fs::path& file)
-{
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
 
 struct Codec {
     const char* name;   ///< --codec NAME

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <string_view>
 #include <system_error>
 #include <utility>
@@ -13,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sources/ImageIO.hpp"
+#include "sources/PathNames.hpp"
 
 namespace defocus {
 namespace {
@@ -23,50 +23,7 @@ bool isImageFile(const fs::path& file)
 {
     static constexpr std::array<std::string_view, 8> extensions = {
         ".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".bmp", ".webp"};
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return std::find(extensions.begin(), extensions.end(), ext) != extensions.end();
-}
-
-bool isDigit(char c)
-{
-    return std::isdigit(static_cast<unsigned char>(c)) != 0;
-}
-
-// Natural order: runs of digits compare by value, so "frame2" sorts before "frame10".
-bool naturalLess(std::string_view a, std::string_view b)
-{
-    std::size_t i = 0;
-    std::size_t j = 0;
-    while (i < a.size() && j < b.size()) {
-        if (isDigit(a[i]) && isDigit(b[j])) {
-            std::size_t iEnd = i;
-            std::size_t jEnd = j;
-            while (iEnd < a.size() && isDigit(a[iEnd]))
-                ++iEnd;
-            while (jEnd < b.size() && isDigit(b[jEnd]))
-                ++jEnd;
-            std::string_view x = a.substr(i, iEnd - i);
-            std::string_view y = b.substr(j, jEnd - j);
-            x.remove_prefix(std::min(x.find_first_not_of('0'), x.size()));
-            y.remove_prefix(std::min(y.find_first_not_of('0'), y.size()));
-            if (x.size() != y.size())
-                return x.size() < y.size();
-            if (x != y)
-                return x < y;
-            i = iEnd;
-            j = jEnd;
-        } else {
-            if (a[i] != b[j])
-                return a[i] < b[j];
-            ++i;
-            ++j;
-        }
-    }
-    if (a.size() - i != b.size() - j)
-        return a.size() - i < b.size() - j;
-    return a < b; // equal by value ("f01" and "f1"): any fixed order
+    return std::find(extensions.begin(), extensions.end(), lowerExtension(file)) != extensions.end();
 }
 
 std::vector<fs::path> listImages(const fs::path& folder)

@@ -2,17 +2,14 @@
 // file) and opens the matching source.
 #include "sources/FrameSource.hpp"
 
-#include <algorithm>
-#include <array>
-#include <cctype>
 #include <cmath>
-#include <string_view>
 #include <system_error>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "sources/FolderPairSource.hpp"
+#include "sources/PathNames.hpp"
 #include "sources/SingleImageSource.hpp"
 #include "sources/StreamSources.hpp" // cameras and video files
 #include "sources/TumSource.hpp"
@@ -28,16 +25,6 @@ namespace fs = std::filesystem;
 constexpr double tumUnitsPerMetre = 5000.0;
 constexpr double defaultUnitsPerMetre = 1000.0;
 
-bool isVideoFile(const fs::path& file)
-{
-    static constexpr std::array<std::string_view, 6> extensions = {".mp4", ".avi", ".mkv",
-                                                                   ".mov", ".m4v", ".webm"};
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return std::find(extensions.begin(), extensions.end(), ext) != extensions.end();
-}
-
 } // namespace
 
 double defaultDepthScale(const SourceOptions& options)
@@ -46,7 +33,7 @@ double defaultDepthScale(const SourceOptions& options)
     const fs::path& input = options.input;
     if (fs::is_directory(input, ec) && (fs::exists(input / "rgb.txt", ec) || fs::exists(input / "associations.txt", ec)))
         return tumUnitsPerMetre;
-    if (options.depth && options.depth->extension() == ".txt")
+    if (options.depth && lowerExtension(*options.depth) == ".txt")
         return tumUnitsPerMetre;
     return defaultUnitsPerMetre;
 }

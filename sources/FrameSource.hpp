@@ -69,7 +69,8 @@ struct SourceOptions {
     /// Depth for `input`: a folder (paired by sorted file name) or a single file. Not needed
     /// for the TUM layout, which names its own depth files.
     std::optional<std::filesystem::path> depth;
-    /// Units per metre of 16-bit depth images. Unset: 5000 for the TUM layout, 1000 otherwise.
+    /// Units per metre of 16-bit depth images. Unset: 5000 for the TUM layout and a depth list
+    /// (depth.txt), 1000 otherwise.
     std::optional<double> depthScale;
     // ---- streams: `input` may also be a camera (/dev/video*), with `depth` a second
     // camera giving Z16 depth; a video file may take a depth folder or depth.txt (by index).

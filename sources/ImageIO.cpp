@@ -27,17 +27,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// OpenCV reads OPENCV_IO_ENABLE_OPENEXR when it first decodes an EXR file, so setting it before
-// our first imread is enough. A value the user set (even "0") is left alone.
-void enableOpenExr()
-{
-    static const bool enabled = [] {
-        ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
-        return true;
-    }();
-    (void)enabled;
-}
-
 std::string describeSamples(const cv::Mat& image)
 {
     static constexpr const char* depthNames[] = {"8-bit unsigned", "8-bit signed", "16-bit unsigned",
@@ -213,6 +202,17 @@ cv::Mat depthFromRaw(const cv::Mat& raw, double unitsPerMetre, const std::string
 }
 
 } // namespace
+
+// OpenCV reads OPENCV_IO_ENABLE_OPENEXR when it first encodes or decodes an EXR file, so setting
+// it before then is enough.
+void enableOpenExr()
+{
+    static const bool enabled = [] {
+        ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0); // 0: a value the user set (even "0") stays
+        return true;
+    }();
+    (void)enabled;
+}
 
 cv::Mat decodeColor(std::span<const unsigned char> bytes, const std::string& name, std::size_t maxPixels)
 {

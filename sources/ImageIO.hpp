@@ -19,6 +19,11 @@ inline constexpr std::size_t kMaxImagePixels = std::size_t{1} << 27;
 /// other formats OpenCV knows are refused. Truncated PNG, JPEG, WebP and scan-line EXR files are
 /// caught from their structure (libjpeg alone would pad a cut JPEG with grey and carry on).
 
+/// Lets OpenCV encode and decode OpenEXR (OPENCV_IO_ENABLE_OPENEXR=1) unless the environment
+/// already holds a value, which is kept (even "0"). Call before OpenCV's first EXR imread or
+/// imwrite; the readers and writers here do. Thread-safe; sets the variable once.
+void enableOpenExr();
+
 /// Reads a colour image. 8-bit files (PNG, JPEG, ...) give CV_8UC3 sRGB; grey or with alpha are
 /// converted to BGR. 16-bit files give CV_32FC3 scene-linear (sRGB decoded). EXR and float TIFF
 /// give CV_32FC3 scene-linear, unclipped. Throws SourceError naming the file on failure.

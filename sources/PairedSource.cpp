@@ -3,7 +3,6 @@
 #include "sources/PairedSource.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -17,6 +16,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sources/ImageIO.hpp"
+#include "sources/PathNames.hpp"
 #include "sources/TumLists.hpp"
 
 namespace defocus {
@@ -24,52 +24,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string lowerExtension(const fs::path& file)
-{
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
-
 bool isDepthImage(const fs::path& file)
 {
     const std::string ext = lowerExtension(file);
     return ext == ".png" || ext == ".tif" || ext == ".tiff" || ext == ".exr";
-}
-
-/// "d2" before "d10": runs of digits compare by value, everything else by character.
-bool naturalLess(std::string_view a, std::string_view b)
-{
-    const auto digit = [](char c) { return c >= '0' && c <= '9'; };
-    std::size_t i = 0, j = 0;
-    while (i < a.size() && j < b.size()) {
-        if (digit(a[i]) && digit(b[j])) {
-            std::size_t ei = i, ej = j;
-            while (ei < a.size() && digit(a[ei]))
-                ++ei;
-            while (ej < b.size() && digit(b[ej]))
-                ++ej;
-            // Compare the runs without leading zeros: longer is larger, then lexicographically.
-            std::string_view ra = a.substr(i, ei - i), rb = b.substr(j, ej - j);
-            while (ra.size() > 1 && ra.front() == '0')
-                ra.remove_prefix(1);
-            while (rb.size() > 1 && rb.front() == '0')
-                rb.remove_prefix(1);
-            if (ra.size() != rb.size())
-                return ra.size() < rb.size();
-            if (ra != rb)
-                return ra < rb;
-            i = ei;
-            j = ej;
-        } else {
-            if (a[i] != b[j])
-                return a[i] < b[j];
-            ++i;
-            ++j;
-        }
-    }
-    return a.size() - i < b.size() - j;
 }
 
 /// A file stem that is wholly a number ("1305031250.253735") as seconds.

@@ -1,8 +1,6 @@
 // Opens cameras and pairs colour with depth from another source, by what the paths name.
 #include "sources/StreamSources.hpp"
 
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <string>
 #include <system_error>
@@ -11,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sources/PairedSource.hpp"
+#include "sources/PathNames.hpp"
 #include "sources/V4l2Source.hpp"
 #include "sources/VideoFileSource.hpp"
 
@@ -23,21 +22,6 @@ namespace fs = std::filesystem;
 /// 1/5000 m, everything else (RealSense, Kinect SDK, Blender's 16-bit export) in millimetres.
 constexpr double tumUnitsPerMetre = 5000.0;
 constexpr double defaultUnitsPerMetre = 1000.0;
-
-std::string lowerExtension(const fs::path& file)
-{
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
-
-bool isVideoFile(const fs::path& file)
-{
-    const std::string ext = lowerExtension(file);
-    return ext == ".mp4" || ext == ".avi" || ext == ".mkv" || ext == ".mov" || ext == ".m4v" ||
-           ext == ".webm";
-}
 
 bool isDepthSequence(const fs::path& depth)
 {

@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 
 void writeImage(const fs::path& file, const cv::Mat& image)
 {
-    ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+    enableOpenExr();
     fs::create_directories(file.parent_path());
     ASSERT_TRUE(cv::imwrite(file.string(), image)) << file;
 }

@@ -206,7 +206,7 @@ TEST(Reports, WriteIsAtomicAndLeavesNoTemporary)
 TEST(Reports, BuildInfoNamesVersionAndCommit)
 {
     const auto info = buildInfo();
-    EXPECT_EQ(info["version"], "0.1.0");
+    EXPECT_EQ(info["version"], DEFOCUS_VERSION);
     EXPECT_FALSE(info["commit"].get<std::string>().empty());
     EXPECT_FALSE(info["opencv"].get<std::string>().empty());
     EXPECT_FALSE(info["host"].get<std::string>().empty());
@@ -280,7 +280,7 @@ TEST(RunBatch, StopLeavesUnfinishedClipsToTheRerunAndSkipsDoneOnes)
     EXPECT_EQ(report["exit_status"], 0);
     EXPECT_EQ(report["frames_out"], 3);
     EXPECT_EQ(report["clip"]["manifest_line"], 1);
-    EXPECT_EQ(report["build"]["version"], "0.1.0");
+    EXPECT_EQ(report["build"]["version"], DEFOCUS_VERSION);
 
     batch.statusOf.clear();
     batch.stop = 0;

@@ -52,8 +52,7 @@ TEST_F(HighlightSprites, ALightBecomesAHexagonWithExactEdgesAndAllItsEnergy)
     // area it covers of each pixel (the CPU reference's polygonSquareOverlap). The sprite's edge
     // ramp is one pixel wide, like an area-sampled edge.
     const double radius = diameter / 2.0;
-    ScatterOptions corners;
-    corners.rotationDeg = 90.0f;
+    const ScatterOptions corners; // rotation 0: a corner on top, as the lens's
     cv::Mat exact(gray.size(), CV_64F, cv::Scalar(0.0));
     for (int y = 0; y < gray.rows; ++y)
         for (int x = 0; x < gray.cols; ++x)

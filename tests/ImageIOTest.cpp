@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 // switched on here too (ctest sets it; a direct run of the binary does not).
 void writeFixture(const fs::path& file, const cv::Mat& image)
 {
-    ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+    enableOpenExr();
     ASSERT_TRUE(cv::imwrite(file.string(), image)) << file;
 }
 

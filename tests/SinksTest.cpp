@@ -18,6 +18,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "sinks/FrameSink.hpp"
+#include "sources/ImageIO.hpp"
 #include "sources/FrameSource.hpp"
 #include "tests/TestSupport.hpp"
 
@@ -28,7 +29,7 @@ namespace fs = std::filesystem;
 
 cv::Mat readBack(const fs::path& file)
 {
-    ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+    enableOpenExr();
     return cv::imread(file.string(), cv::IMREAD_UNCHANGED);
 }
 

@@ -349,6 +349,15 @@ TEST(OpenSource, MissingInputSaysItDoesNotExist)
     EXPECT_NE(scale.find("depth scale"), std::string::npos) << scale;
 }
 
+// Defect caught: a TUM list given as --depth in capitals ("DEPTH.TXT") read at the list's 5000
+// units per metre but reported and checked at 1000, which warns of a wrong scale that is right.
+TEST(OpenSource, DepthListScaleInAnyCase)
+{
+    for (const char* name : {"depth.txt", "DEPTH.TXT"})
+        EXPECT_EQ(defaultDepthScale({"clip.mp4", fs::path("takes") / name, std::nullopt}), 5000.0) << name;
+    EXPECT_EQ(defaultDepthScale({"clip.mp4", fs::path("takes") / "depth.png", std::nullopt}), 1000.0);
+}
+
 TEST(VideoFileSource, DecodesEveryFrameAndAppliesOneDepthImage)
 {
     const fs::path dir = test::scratchDir("VideoFile");

@@ -15,8 +15,8 @@ namespace defocus {
 ReferenceMethod::ReferenceMethod(std::string_view name) : info_(findMethod(name))
 {
     assert(info_ && !info_->gpu);
-    if (name == "reference-pointy")
-        options_.rotationDeg = 90.0f;
+    if (name == "reference")
+        options_.rotationDeg = 30.0f; // flat top and bottom, as --blade-rotation 30
 }
 
 MethodResult ReferenceMethod::process(const Frame& frame, const LensSettings& lens, const MethodSettings&)

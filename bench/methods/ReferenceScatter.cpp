@@ -33,7 +33,8 @@ struct Polygon {
         CV_Assert(options.blades >= 3 && options.blades <= 16);
         count = options.blades;
         const double step = 2.0 * std::numbers::pi / count;
-        const double rotation = options.rotationDeg * std::numbers::pi / 180.0;
+        // The first corner at 90 degrees (on top) when rotationDeg is 0.
+        const double rotation = (90.0 + options.rotationDeg) * std::numbers::pi / 180.0;
         for (int i = 0; i < count; ++i) {
             const double angle = rotation + step * i; // counter-clockwise on screen: y goes up
             corners[static_cast<std::size_t>(i)] = {std::cos(angle), -std::sin(angle)};

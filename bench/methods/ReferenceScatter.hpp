@@ -17,10 +17,10 @@ struct ScatterOptions {
     float layerGapPx = 2.0f;
     /// Aperture blades: the polygon's corner count, [3, 16].
     int blades = 6;
-    /// Polygon rotation, degrees counter-clockwise on screen. 0 puts a corner on the +x axis:
-    /// for 6 blades, flat top and bottom edges, the McIntosh chain's hexagon. 90 (= 30) puts a
-    /// corner at the top, which is what Blender Cycles renders for "blade rotation 0" (its
-    /// regular_polygon_sample() centres an edge, not a corner, on its rotation angle).
+    /// Polygon rotation, degrees counter-clockwise on screen, as LensSettings::bladeRotationDeg:
+    /// 0 puts a corner on top, which is what Blender Cycles renders for "blade rotation 0" (its
+    /// regular_polygon_sample() centres an edge, not a corner, on its rotation angle). For 6
+    /// blades, 30 gives flat top and bottom edges, the McIntosh chain's hexagon.
     float rotationDeg = 0.0f;
 };
 
@@ -30,7 +30,7 @@ struct ScatterOptions {
 double polygonSquareOverlap(const ScatterOptions& options, double cx, double cy, double radius, double x, double y);
 
 /// Scatters every pixel of `linear` (CV_32FC3 scene-linear, HDR kept; finite, >= 0) as the
-/// aperture polygon (by default a regular hexagon with flat top and bottom edges) whose
+/// aperture polygon (by default a regular hexagon with a corner on top) whose
 /// circumscribed diameter is |CoC| from `cocPx` (CV_32FC1 signed CoC diameter in pixels, near <
 /// 0 < far). The light of a pixel is spread evenly over its polygon (hexagon area
 /// 3 sqrt(3) / 8 d^2): each destination pixel receives colour * overlap / area, so light that

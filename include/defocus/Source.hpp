@@ -5,8 +5,9 @@
 //
 // Inputs, as the command line takes them: a TUM RGB-D folder (rgb.txt + depth.txt, files named by
 // timestamp), a folder of colour images with `depth` a folder (paired by sorted name) or one file,
-// one image with one depth image, a video file with a depth folder or TUM depth list, and a V4L2
-// camera (/dev/videoN) with `depth` a depth image or a Z16 depth camera (/dev/videoM).
+// one image with one depth image, a video file with a depth folder or TUM depth list (paired by
+// index), and a V4L2 camera (/dev/videoN) with `depth` a depth image or a Z16 depth camera
+// (/dev/videoM).
 // Threads: a Source is used from one thread at a time; it makes no GL context.
 #pragma once
 
@@ -35,8 +36,8 @@ struct SourceSettings {
     /// --depth: a folder, an image, a TUM depth list or a Z16 camera; empty where the input names
     /// its own depth (TUM) or has none (the frames pass through in focus).
     std::string depth;
-    /// --depth-scale: units per metre of 16-bit depth images, > 0. Unset: 5000 for TUM folders,
-    /// 1000 otherwise.
+    /// --depth-scale: units per metre of 16-bit depth images, > 0. Unset: 5000 for TUM folders
+    /// and a TUM depth list, 1000 otherwise.
     std::optional<double> depthScale;
     /// A camera is asked for this size (pixels) and rate (Hz); it answers with the nearest it has.
     int width = 640;
@@ -79,7 +80,9 @@ public:
     double frameRate() const;
     /// A camera (frames come in real time and do not end by themselves).
     bool isLive() const;
-    /// One line: kind and location, e.g. "TUM RGB-D sequence data/tum_fr1_rpy (44 pairs)".
+    /// One line: kind, location and how colour meets depth, e.g. for the bundled clip
+    /// "TUM RGB-D sequence 'data/tum_fr1_rpy' (10 frames, 10 with depth, paired by
+    /// associations.txt, 30 Hz)".
     std::string describe() const;
 
 private:
