@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "filter/Settings.hpp"
+#include "defocus/Log.hpp"
 #include "defocus/Settings.hpp"
 #include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
@@ -29,9 +30,14 @@ namespace defocus::cli {
 /// "PROGRAM: error: MESSAGE (see --help)" to standard error and gives kExitUsage. nullopt: go on.
 std::optional<int> parse(CLI::App& app, int argc, char** argv);
 
-/// Sends every log line (spdlog's default logger) to standard error as "PROGRAM: LEVEL: ...";
-/// standard output keeps only results. quiet: warnings and errors only; verbose: debug too.
+/// Sends every log line (spdlog's default logger, and the library's through forwardLibraryLog) to
+/// standard error as "PROGRAM: LEVEL: ..."; standard output keeps only results. quiet: warnings
+/// and errors only; verbose: debug too.
 void logToStderr(std::string_view program, bool quiet = false, bool verbose = false);
+
+/// A defocus::LogHandler that logs the library's message through spdlog's default logger, as the
+/// program's own: defocus::setLogHandler(forwardLibraryLog, LogLevel::Debug) for libdefocus.
+void forwardLibraryLog(LogLevel level, std::string_view message);
 
 /// One line on standard error, "PROGRAM: error: MESSAGE", for use before logToStderr.
 void printError(std::string_view program, std::string_view message);

@@ -19,6 +19,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 namespace defocus {
 namespace {
 
@@ -154,7 +156,7 @@ ImageSequenceSink::~ImageSequenceSink()
     try {
         finish();
     } catch (const std::exception& e) {
-        spdlog::error("{}", e.what());
+        logger().error("{}", e.what());
     }
 }
 
@@ -213,7 +215,7 @@ void ImageSequenceSink::finish()
     std::error_code ec;
     if (written_ == 0) {
         if (createdFolder_ && fs::is_empty(folder_, ec) && fs::remove(folder_, ec))
-            spdlog::warn("sequence '{}': no frames written, so the folder it created is removed",
+            logger().warn("sequence '{}': no frames written, so the folder it created is removed",
                          folder_.string());
         return;
     }

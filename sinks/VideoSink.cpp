@@ -19,6 +19,8 @@
 #include <opencv2/videoio/registry.hpp>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 namespace defocus {
 namespace {
 
@@ -165,14 +167,14 @@ VideoSink::VideoSink(fs::path file, double fps, const std::string& codec) : file
             codecName_ = candidate;
             break;
         }
-        spdlog::debug("video '{}': codec {} ({}) does not open here", file_.string(), candidate, fourcc);
+        logger().debug("video '{}': codec {} ({}) does not open here", file_.string(), candidate, fourcc);
     }
     if (codec_.empty())
         throw SinkError(fmt::format("cannot write video '{}': no encoder opens for codec {} in a {} file "
                                     "(OpenCV's FFmpeg lacks it, or the container cannot hold it)",
                                     file_.string(), joined(codecs), ext));
     if (codecName_ != codecs.front())
-        spdlog::warn("video '{}': codec {} unavailable, using {}", file_.string(), codecs.front(), codecName_);
+        logger().warn("video '{}': codec {} unavailable, using {}", file_.string(), codecs.front(), codecName_);
 }
 
 VideoSink::~VideoSink()
@@ -180,7 +182,7 @@ VideoSink::~VideoSink()
     try {
         finish();
     } catch (const std::exception& e) {
-        spdlog::error("{}", e.what());
+        logger().error("{}", e.what());
     }
 }
 
@@ -195,7 +197,7 @@ bool VideoSink::openWriter(cv::VideoWriter& writer, const std::string& fourcc, c
                                cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]), fps_, size, true);
         });
     } catch (const cv::Exception& e) {
-        spdlog::debug("video '{}': {} failed to open: {}", file_.string(), fourcc, e.err);
+        logger().debug("video '{}': {} failed to open: {}", file_.string(), fourcc, e.err);
         return false;
     }
 }
@@ -216,7 +218,7 @@ void VideoSink::write(const cv::Mat& image)
                                         file_.string(), codec_, image.cols, image.rows));
         size_ = image.size();
         if (size_.width % 2 != 0 || size_.height % 2 != 0)
-            spdlog::warn("video '{}': frames are {}x{}; codecs with 4:2:0 chroma store {}x{}",
+            logger().warn("video '{}': frames are {}x{}; codecs with 4:2:0 chroma store {}x{}",
                          file_.string(), size_.width, size_.height, size_.width & ~1,
                          size_.height & ~1);
     } else if (image.size() != size_) {
@@ -238,7 +240,7 @@ void VideoSink::finish()
     std::error_code ec;
     if (written_ == 0) {
         fs::remove(partial_, ec);
-        spdlog::warn("video '{}': no frames written, so no file created", file_.string());
+        logger().warn("video '{}': no frames written, so no file created", file_.string());
         return;
     }
     fs::rename(partial_, file_, ec);

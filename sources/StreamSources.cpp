@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 #include "sources/PairedSource.hpp"
 #include "sources/V4l2Source.hpp"
 #include "sources/VideoFileSource.hpp"
@@ -81,7 +83,7 @@ std::unique_ptr<FrameSource> openStreamSource(const SourceOptions& options)
         colour.pixelFormat = options.pixelFormat;
         auto camera = std::make_unique<V4l2Source>(colour);
         if (!options.depth) {
-            spdlog::warn("camera {}: no depth given; its frames pass through in focus",
+            logger().warn("camera {}: no depth given; its frames pass through in focus",
                          options.input.string());
             return camera;
         }

@@ -10,6 +10,8 @@
 #include <opencv2/videoio/registry.hpp>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 #include "sources/ImageIO.hpp"
 
 namespace defocus {
@@ -45,7 +47,7 @@ VideoFileSource::VideoFileSource(std::filesystem::path file,
     if (depthFile_)
         depth_ = readDepth(*depthFile_, unitsPerMetre);
     else
-        spdlog::warn("video '{}': no depth given; its frames pass through in focus",
+        logger().warn("video '{}': no depth given; its frames pass through in focus",
                      file_.string());
 }
 
@@ -65,7 +67,7 @@ std::optional<Frame> VideoFileSource::next()
         ended_ = true;
         capture_.release();
         if (frameCount_ && next_ < *frameCount_)
-            spdlog::warn("video '{}': decoding stopped after {} of the {} frames its header states; "
+            logger().warn("video '{}': decoding stopped after {} of the {} frames its header states; "
                          "the file is truncated or damaged, and the frames written so far are kept",
                          file_.string(), next_, *frameCount_);
         return std::nullopt;
