@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "defocus/Settings.hpp" // limits: the ranges
+
 namespace defocus {
 
 /// How depth becomes a circle of confusion.
@@ -175,15 +177,5 @@ bool parseFocus(std::string_view text, LensSettings& lens, bool& isAuto);
 /// The strict check of a command line: validate() of both structs, with an automatic focus
 /// treated as valid (it is chosen, and checked, once the first depth is known).
 std::vector<SettingIssue> validateCommandLine(const LensSettings& lens, QualitySettings quality, bool autoFocus);
-
-namespace limits {
-inline constexpr double kFocalLengthMm[] = {1.0, 1200.0};
-inline constexpr double kFNumber[] = {0.7, 64.0};
-inline constexpr double kSensorWidthMm[] = {1.0, 100.0};
-inline constexpr double kMaxCocPx[] = {0.0, 512.0};
-inline constexpr double kBladeRotationDeg[] = {-180.0, 180.0};
-inline constexpr int kSamples[] = {2, 64};
-inline constexpr double kHighlightGain[] = {1.0, 64.0};
-} // namespace limits
 
 } // namespace defocus

@@ -1,11 +1,14 @@
-// The GStreamer element `defocus`: colour on the `color` pad, depth on the `depth` pad, paired by
-// running time (GstVideoAggregator), the depth of field of a lens out of `src`. It uses only
-// libdefocus' public API, on an EGL context of its own made on the streaming thread.
+// The GStreamer element `defocus`: colour on the `color` pad, depth on the `depth` pad, the depth
+// of field of a lens out of `src`, one frame per colour frame with its timestamp and duration,
+// each paired with the depth current at its running time (a GstVideoAggregator that runs its own
+// aggregate()). It uses only libdefocus' public API, on an EGL context of its own made on the
+// streaming thread; the library's messages go to GStreamer's log (gst/LibraryLog.hpp).
 //   gst-launch-1.0 defocus name=d focus=1.2 f-number=1.4 ! videoconvert ! autovideosink
 //     filesrc location=clip.mp4 ! decodebin ! videoconvert ! d.color
 //     filesrc location=depth.png ! pngdec ! imagefreeze ! d.depth         (one line)
 #include "gst/GstDefocus.hpp"
 #include "gst/GstDefocusSrc.hpp"
+#include "gst/LibraryLog.hpp"
 
 #include <atomic>
 #include <cmath>
@@ -38,6 +41,10 @@ struct State {
     unsigned applied = 0;           ///< generation the filter has
     std::set<std::string> warned;   ///< settings problems already posted as warnings
     std::atomic<bool> resetPending{false}; ///< a flush happened: the next frame starts a new stream
+    std::atomic<bool> depthStale{false};   ///< a flush happened: the depth frame is from before it
+    GstBuffer* depthFrame = nullptr;       ///< the depth frame current at the last colour frame
+    GstClockTime depthEnd = GST_CLOCK_TIME_NONE; ///< its end, running time (NONE: no duration)
+    GstClockTime lastDuration = GST_SECOND / 30; ///< the last colour frame's (a live deadline's step)
 };
 
 } // namespace
@@ -316,9 +323,6 @@ GstAggregatorPad* createNewPad(GstAggregator* agg, GstPadTemplate* templ, const 
                                                       GST_PAD_SINK, "template", templ, nullptr));
     slot = pad;
     GST_OBJECT_UNLOCK(agg);
-    // A depth stream that ends (one still image) keeps its last frame for the rest of the colour.
-    if (!isColor)
-        g_object_set(pad, "repeat-after-eos", TRUE, nullptr);
     return GST_AGGREGATOR_PAD(pad);
 }
 
@@ -377,8 +381,9 @@ gboolean sinkQuery(GstAggregator* agg, GstAggregatorPad* pad, GstQuery* query)
 
 // ---- caps ----------------------------------------------------------------------------------------
 
-/// The output has the colour's size, frame rate and pixel aspect; its format is the colour's
-/// when that is one of the output formats, else what downstream prefers of them.
+/// The output has the colour's size, frame rate (0/1, variable, where the colour's is) and pixel
+/// aspect; its format is the colour's when that is one of the output formats, else what
+/// downstream prefers of them.
 GstFlowReturn updateSrcCaps(GstAggregator* agg, GstCaps* downstream, GstCaps** result)
 {
     auto* self = GST_DEFOCUS(agg);
@@ -398,8 +403,8 @@ GstFlowReturn updateSrcCaps(GstAggregator* agg, GstCaps* downstream, GstCaps** r
     GstCaps* shape = gst_caps_new_simple("video/x-raw", "width", G_TYPE_INT, info.width, "height", G_TYPE_INT,
                                          info.height, "pixel-aspect-ratio", GST_TYPE_FRACTION, info.par_n,
                                          info.par_d, nullptr);
-    if (info.fps_n > 0)
-        gst_caps_set_simple(shape, "framerate", GST_TYPE_FRACTION, info.fps_n, info.fps_d, nullptr);
+    // The colour's rate; 0/1 (variable: each frame has its own duration, a still image) stays so.
+    gst_caps_set_simple(shape, "framerate", GST_TYPE_FRACTION, info.fps_n, info.fps_n > 0 ? info.fps_d : 1, nullptr);
     GstCaps* possible = gst_caps_intersect(downstream, shape);
     gst_caps_unref(shape);
 
@@ -413,55 +418,69 @@ GstFlowReturn updateSrcCaps(GstAggregator* agg, GstCaps* downstream, GstCaps** r
     return GST_FLOW_OK;
 }
 
+/// The output's caps taken: the base class' work (GstVideoAggregator's, which divides by the
+/// frame rate and so cannot take a variable one), done here. Latency: one frame of the output's
+/// rate (a live colour frame waits that long for its depth); none at a variable rate.
+gboolean negotiatedSrcCaps(GstAggregator* agg, GstCaps* caps)
+{
+    auto* self = GST_DEFOCUS(agg);
+    GstVideoInfo info;
+    if (!gst_video_info_from_caps(&info, caps))
+        return FALSE;
+    GST_OBJECT_LOCK(agg);
+    GST_VIDEO_AGGREGATOR(agg)->info = info;
+    GST_OBJECT_UNLOCK(agg);
+    GstVideoAggregatorPad *color = nullptr, *depth = nullptr;
+    pads(self, color, depth);
+    if (color) {
+        // The colour pad converts to the new output format from its next frame on.
+        gst_video_aggregator_convert_pad_update_conversion_info(GST_VIDEO_AGGREGATOR_CONVERT_PAD(color));
+        gst_object_unref(color);
+    }
+    if (depth)
+        gst_object_unref(depth);
+    gst_aggregator_set_src_caps(agg, caps);
+    const GstClockTime frame =
+        info.fps_n > 0 ? gst_util_uint64_scale_int(GST_SECOND, info.fps_d, info.fps_n) : GstClockTime{0};
+    gst_aggregator_set_latency(agg, frame, frame);
+    return TRUE;
+}
+
+/// New caps on a pad that has some: the base class would hold them back until its own output grid
+/// takes the next buffer, which this element does not use. Serialized events reach the element
+/// in order with the buffers, so the next buffer is the first in the new caps: take them now.
+gboolean sinkEvent(GstAggregator* agg, GstAggregatorPad* pad, GstEvent* event)
+{
+    GstVideoInfo info;
+    bool newCaps = false;
+    if (GST_EVENT_TYPE(event) == GST_EVENT_CAPS) {
+        GstCaps* caps = nullptr;
+        gst_event_parse_caps(event, &caps);
+        newCaps = gst_video_info_from_caps(&info, caps);
+    }
+    const gboolean ok = GST_AGGREGATOR_CLASS(gst_defocus_parent_class)->sink_event(agg, pad, event);
+    if (ok && newCaps) {
+        auto* vpad = GST_VIDEO_AGGREGATOR_PAD(pad);
+        GST_OBJECT_LOCK(agg);
+        const bool changed = !gst_video_info_is_equal(&vpad->info, &info);
+        vpad->info = info;
+        GST_OBJECT_UNLOCK(agg);
+        if (changed) {
+            if (GST_IS_VIDEO_AGGREGATOR_CONVERT_PAD(pad))
+                gst_video_aggregator_convert_pad_update_conversion_info(GST_VIDEO_AGGREGATOR_CONVERT_PAD(pad));
+            gst_pad_mark_reconfigure(agg->srcpad);
+        }
+    }
+    return ok;
+}
+
 GstCaps* fixateSrcCaps(GstAggregator*, GstCaps* caps)
 {
     caps = gst_caps_make_writable(caps);
     GstStructure* s = gst_caps_get_structure(caps, 0);
-    // A colour stream without a frame rate (a still image): the base class' 25 Hz.
-    gst_structure_fixate_field_nearest_fraction(s, "framerate", 25, 1);
     if (gst_structure_has_field(s, "pixel-aspect-ratio"))
         gst_structure_fixate_field_nearest_fraction(s, "pixel-aspect-ratio", 1, 1);
     return gst_caps_fixate(caps);
-}
-
-// ---- streaming -------------------------------------------------------------------------------------
-
-/// Decides whether this output time has a frame: colour and depth both there. The base class
-/// calls it before anything is converted, so a frame that is not made costs nothing.
-GstFlowReturn createOutputBuffer(GstVideoAggregator* vagg, GstBuffer** outbuf)
-{
-    auto* self = GST_DEFOCUS(vagg);
-    GstVideoAggregatorPad *color = nullptr, *depth = nullptr;
-    pads(self, color, depth);
-    GstFlowReturn ret = GST_FLOW_OK;
-    *outbuf = nullptr;
-    if (!depth) {
-        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("No depth stream: link one to the defocus element's 'depth' pad"),
-                          ("defocus needs GRAY16 depth, e.g. '... ! pngdec ! imagefreeze ! d.depth' for one image"));
-        ret = GST_FLOW_ERROR;
-    } else if (!color) {
-        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("No colour stream: link one to the defocus element's 'color' pad"),
-                          (nullptr));
-        ret = GST_FLOW_ERROR;
-    } else if (!gst_video_aggregator_pad_has_current_buffer(color)) {
-        // The colour has ended (depth may go on, e.g. from imagefreeze): so has the output.
-        // Otherwise (a live source, late colour) this output time has no frame.
-        if (gst_aggregator_pad_is_eos(GST_AGGREGATOR_PAD(color)))
-            ret = GST_FLOW_EOS;
-    } else if (!gst_video_aggregator_pad_has_current_buffer(depth)) {
-        if (gst_aggregator_pad_is_eos(GST_AGGREGATOR_PAD(depth))) {
-            GST_ELEMENT_ERROR(self, STREAM, FAILED, ("The depth stream ended before its first frame"), (nullptr));
-            ret = GST_FLOW_ERROR;
-        }
-        // else a live depth stream has not started yet: this colour frame is dropped.
-    } else {
-        ret = GST_VIDEO_AGGREGATOR_CLASS(gst_defocus_parent_class)->create_output_buffer(vagg, outbuf);
-    }
-    if (color)
-        gst_object_unref(color);
-    if (depth)
-        gst_object_unref(depth);
-    return ret;
 }
 
 /// A view of `frame`'s first plane as a cv::Mat (no copy).
@@ -560,11 +579,52 @@ defocus::Settings currentSettings(GstDefocus* self, bool& changed, bool& post)
     return settings;
 }
 
-GstFlowReturn aggregateFrames(GstVideoAggregator* vagg, GstBuffer* outbuf)
+// ---- streaming -------------------------------------------------------------------------------------
+//
+// One output frame per colour frame, with its timestamp and duration: the element drives the
+// base class' aggregate() itself instead of GstVideoAggregator's output grid, which runs at one
+// frame rate and repeats (or drops) colour frames whose timestamps do not fall on it (recorded
+// RGB-D clips have gaps where the sensor dropped frames). The colour pad still converts the colour
+// to the output's format, and the caps are still negotiated by the base class.
+
+/// Running time of `buffer`'s start in `pad`'s segment; NONE without a timestamp.
+GstClockTime runningTimeOf(GstAggregatorPad* pad, GstBuffer* buffer)
 {
-    auto* self = GST_DEFOCUS(vagg);
+    GST_OBJECT_LOCK(pad);
+    const GstClockTime t = gst_segment_to_running_time(&pad->segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+    GST_OBJECT_UNLOCK(pad);
+    return t;
+}
+
+/// Moves the output position on by `duration` (a live stream with no colour frame in time), so
+/// that the base class' next deadline is one frame later.
+void advance(GstAggregator* agg, GstClockTime duration)
+{
+    GST_OBJECT_LOCK(agg);
+    GstSegment& segment = GST_AGGREGATOR_PAD(agg->srcpad)->segment;
+    if (!GST_CLOCK_TIME_IS_VALID(segment.position) || segment.position < segment.start)
+        segment.position = segment.start;
+    segment.position += duration;
+    GST_OBJECT_UNLOCK(agg);
+}
+
+/// The colour frame's duration: its own, else one frame of the output's rate, else NONE
+/// (variable rate without durations).
+GstClockTime durationOf(GstVideoAggregator* vagg, GstBuffer* color)
+{
+    if (GST_BUFFER_DURATION_IS_VALID(color))
+        return GST_BUFFER_DURATION(color);
+    if (GST_VIDEO_INFO_FPS_N(&vagg->info) > 0)
+        return gst_util_uint64_scale_int(GST_SECOND, GST_VIDEO_INFO_FPS_D(&vagg->info),
+                                         GST_VIDEO_INFO_FPS_N(&vagg->info));
+    return GST_CLOCK_TIME_NONE;
+}
+
+/// Filters `color` (the output's format) with `depth` into `outbuf`, whose PTS is set.
+GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, GstVideoFrame* depth)
+{
     State& s = *self->state;
-    GstAggregator* agg = GST_AGGREGATOR(vagg);
+    GstAggregator* agg = GST_AGGREGATOR(self);
 
     // Keyframed properties (GstController) at this frame's stream time.
     const GstClockTime pts = GST_BUFFER_PTS(outbuf);
@@ -577,6 +637,7 @@ GstFlowReturn aggregateFrames(GstVideoAggregator* vagg, GstBuffer* outbuf)
 
     bool changed = false, post = false;
     const defocus::Settings settings = currentSettings(self, changed, post);
+    const defocus::gst::LibraryCall call(GST_ELEMENT(self));
 
     try {
         if (!s.filter) {
@@ -598,16 +659,9 @@ GstFlowReturn aggregateFrames(GstVideoAggregator* vagg, GstBuffer* outbuf)
         s.resetPending = false;
     }
 
-    GstVideoAggregatorPad *colorPad = nullptr, *depthPad = nullptr;
-    pads(self, colorPad, depthPad);
-    GstVideoFrame* color = colorPad ? gst_video_aggregator_pad_get_prepared_frame(colorPad) : nullptr;
-    GstVideoFrame* depth = depthPad ? gst_video_aggregator_pad_get_prepared_frame(depthPad) : nullptr;
     GstFlowReturn ret = GST_FLOW_OK;
     GstVideoFrame out;
-    if (!color || !depth || !color->buffer || !depth->buffer) {
-        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("A colour or depth frame could not be mapped"), (nullptr));
-        ret = GST_FLOW_ERROR;
-    } else if (!gst_video_frame_map(&out, &vagg->info, outbuf, GST_MAP_WRITE)) {
+    if (!gst_video_frame_map(&out, &GST_VIDEO_AGGREGATOR(self)->info, outbuf, GST_MAP_WRITE)) {
         GST_ELEMENT_ERROR(self, RESOURCE, WRITE, ("The output buffer could not be mapped"), (nullptr));
         ret = GST_FLOW_ERROR;
     } else {
@@ -629,16 +683,161 @@ GstFlowReturn aggregateFrames(GstVideoAggregator* vagg, GstBuffer* outbuf)
     }
     // The streaming thread may be another one after a seek or a pause: let it take the context.
     s.filter->release();
-    if (colorPad)
-        gst_object_unref(colorPad);
-    if (depthPad)
-        gst_object_unref(depthPad);
     return ret;
+}
+
+/// Brings the depth frame up to the colour frame at running time `colorTime`: the last depth
+/// frame that starts at or before it (the first one for colour that starts before any depth).
+/// False: a depth frame queued later may still start at or before it (wait for more data).
+bool catchUpDepth(State& s, GstAggregatorPad* depth, GstClockTime colorTime)
+{
+    if (!GST_CLOCK_TIME_IS_VALID(colorTime)) {
+        // Colour without timestamps: paired in order, the next depth frame while depth lasts.
+        if (GstBuffer* next = gst_aggregator_pad_pop_buffer(depth)) {
+            gst_buffer_replace(&s.depthFrame, next);
+            s.depthEnd = GST_CLOCK_TIME_NONE;
+            gst_buffer_unref(next);
+        }
+        return s.depthFrame || gst_aggregator_pad_is_eos(depth);
+    }
+    while (GstBuffer* next = gst_aggregator_pad_peek_buffer(depth)) {
+        const GstClockTime start = runningTimeOf(depth, next);
+        if (s.depthFrame && GST_CLOCK_TIME_IS_VALID(start) && start > colorTime) {
+            gst_buffer_unref(next);
+            return true;
+        }
+        gst_buffer_replace(&s.depthFrame, next);
+        s.depthEnd = GST_CLOCK_TIME_IS_VALID(start) && GST_BUFFER_DURATION_IS_VALID(next)
+                         ? start + GST_BUFFER_DURATION(next)
+                         : GST_CLOCK_TIME_NONE;
+        gst_buffer_unref(next);
+        gst_aggregator_pad_drop_buffer(depth);
+    }
+    // Nothing queued: known when the depth has ended or the current frame lasts past the colour's.
+    return gst_aggregator_pad_is_eos(depth) || (GST_CLOCK_TIME_IS_VALID(s.depthEnd) && s.depthEnd > colorTime);
+}
+
+/// The element's GstAggregator::aggregate: the next colour frame, paired with the depth frame
+/// current at its running time, filtered and pushed with the colour's timestamp and duration.
+/// Not live, the base class calls it once both pads have data or have ended; live, also at each
+/// deadline (timeout), where a colour frame whose depth is late is dropped rather than waited for.
+GstFlowReturn aggregate(GstAggregator* agg, gboolean timeout)
+{
+    auto* self = GST_DEFOCUS(agg);
+    auto* vagg = GST_VIDEO_AGGREGATOR(agg);
+    State& s = *self->state;
+    GstVideoAggregatorPad *colorPad = nullptr, *depthPad = nullptr;
+    pads(self, colorPad, depthPad);
+    const auto unrefPads = [&] {
+        if (colorPad)
+            gst_object_unref(colorPad);
+        if (depthPad)
+            gst_object_unref(depthPad);
+    };
+    if (!depthPad || !colorPad) {
+        if (!depthPad)
+            GST_ELEMENT_ERROR(self, STREAM, FAILED, ("No depth stream: link one to the defocus element's 'depth' pad"),
+                              ("defocus needs GRAY16 depth, e.g. '... ! pngdec ! imagefreeze ! d.depth' for one image"));
+        else
+            GST_ELEMENT_ERROR(self, STREAM, FAILED, ("No colour stream: link one to the defocus element's 'color' pad"),
+                              (nullptr));
+        unrefPads();
+        return GST_FLOW_ERROR;
+    }
+    auto* color = GST_AGGREGATOR_PAD(colorPad);
+    auto* depth = GST_AGGREGATOR_PAD(depthPad);
+    if (s.depthStale.exchange(false))
+        gst_clear_buffer(&s.depthFrame); // a flush: depth from before it is not this stream's
+
+    GstBuffer* colorBuffer = gst_aggregator_pad_peek_buffer(color);
+    if (!colorBuffer) {
+        // The colour has ended (depth may go on, e.g. from imagefreeze): so has the output.
+        const bool ended = gst_aggregator_pad_is_eos(color);
+        if (!ended && timeout)
+            advance(agg, s.lastDuration);
+        unrefPads();
+        return ended ? GST_FLOW_EOS : GST_AGGREGATOR_FLOW_NEED_DATA;
+    }
+    if (GST_VIDEO_INFO_FORMAT(&vagg->info) == GST_VIDEO_FORMAT_UNKNOWN) {
+        gst_buffer_unref(colorBuffer); // the output's caps come first (negotiated by the base class)
+        unrefPads();
+        return GST_AGGREGATOR_FLOW_NEED_DATA;
+    }
+    const GstClockTime colorTime = runningTimeOf(color, colorBuffer);
+    const GstClockTime duration = durationOf(vagg, colorBuffer);
+    if (!catchUpDepth(s, depth, colorTime) && !timeout) {
+        gst_buffer_unref(colorBuffer);
+        unrefPads();
+        return GST_AGGREGATOR_FLOW_NEED_DATA;
+    }
+    if (!s.depthFrame && gst_aggregator_pad_is_eos(depth)) {
+        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("The depth stream ended before its first frame"), (nullptr));
+        gst_buffer_unref(colorBuffer);
+        unrefPads();
+        return GST_FLOW_ERROR;
+    }
+    gst_aggregator_pad_drop_buffer(color);
+
+    // The output's timestamp: the colour's running time in the output segment.
+    GstClockTime pts = GST_BUFFER_PTS(colorBuffer);
+    if (GST_CLOCK_TIME_IS_VALID(colorTime)) {
+        GST_OBJECT_LOCK(agg);
+        pts = gst_segment_position_from_running_time(&GST_AGGREGATOR_PAD(agg->srcpad)->segment, GST_FORMAT_TIME,
+                                                     colorTime);
+        GST_OBJECT_UNLOCK(agg);
+    }
+    if (GST_CLOCK_TIME_IS_VALID(duration))
+        s.lastDuration = duration;
+
+    GstFlowReturn ret = GST_FLOW_OK;
+    GstBuffer* outbuf = nullptr;
+    if (!s.depthFrame) {
+        // Live: no depth yet by this colour frame's deadline; it is dropped, not waited for.
+        GST_DEBUG_OBJECT(self, "no depth by %" GST_TIME_FORMAT ": colour frame dropped", GST_TIME_ARGS(colorTime));
+    } else if ((ret = GST_VIDEO_AGGREGATOR_CLASS(gst_defocus_parent_class)->create_output_buffer(vagg, &outbuf)) ==
+                   GST_FLOW_OK &&
+               outbuf) {
+        GST_BUFFER_PTS(outbuf) = pts;
+        GST_BUFFER_DTS(outbuf) = GST_CLOCK_TIME_NONE;
+        GST_BUFFER_DURATION(outbuf) = duration;
+        // The colour in the output's format (the colour pad converts it), the depth as it came.
+        auto* colorClass = GST_VIDEO_AGGREGATOR_PAD_GET_CLASS(colorPad);
+        GstVideoFrame prepared{}, depthFrame{};
+        GST_OBJECT_LOCK(self);
+        GstVideoInfo depthInfo = depthPad->info;
+        GST_OBJECT_UNLOCK(self);
+        const bool colorMapped = colorClass->prepare_frame(colorPad, vagg, colorBuffer, &prepared) && prepared.buffer;
+        const bool depthMapped = gst_video_frame_map(&depthFrame, &depthInfo, s.depthFrame, GST_MAP_READ);
+        if (!colorMapped || !depthMapped) {
+            GST_ELEMENT_ERROR(self, STREAM, FAILED, ("A colour or depth frame could not be mapped"), (nullptr));
+            ret = GST_FLOW_ERROR;
+        } else {
+            ret = render(self, outbuf, &prepared, &depthFrame);
+        }
+        if (depthMapped)
+            gst_video_frame_unmap(&depthFrame);
+        colorClass->clean_frame(colorPad, vagg, &prepared);
+    }
+    gst_buffer_unref(colorBuffer);
+    unrefPads();
+    // The base class' next deadline (live) is the end of this frame.
+    GST_OBJECT_LOCK(agg);
+    GstSegment& segment = GST_AGGREGATOR_PAD(agg->srcpad)->segment;
+    if (GST_CLOCK_TIME_IS_VALID(pts))
+        segment.position = GST_CLOCK_TIME_IS_VALID(duration) ? pts + duration : pts;
+    GST_OBJECT_UNLOCK(agg);
+    if (ret != GST_FLOW_OK || !outbuf) {
+        if (outbuf)
+            gst_buffer_unref(outbuf);
+        return ret;
+    }
+    return gst_aggregator_finish_buffer(agg, outbuf);
 }
 
 GstFlowReturn flush(GstAggregator* agg)
 {
     stateOf(agg).resetPending = true;
+    stateOf(agg).depthStale = true;
     return GST_AGGREGATOR_CLASS(gst_defocus_parent_class)->flush(agg);
 }
 
@@ -649,6 +848,8 @@ gboolean stop(GstAggregator* agg)
     s.filter.reset();
     s.warned.clear();
     s.resetPending = false;
+    s.depthStale = false;
+    gst_clear_buffer(&s.depthFrame);
     {
         std::lock_guard guard(s.lock);
         s.applied = 0;
@@ -658,6 +859,7 @@ gboolean stop(GstAggregator* agg)
 
 void finalize(GObject* object)
 {
+    gst_clear_buffer(&GST_DEFOCUS(object)->state->depthFrame);
     delete GST_DEFOCUS(object)->state;
     G_OBJECT_CLASS(gst_defocus_parent_class)->finalize(object);
 }
@@ -682,35 +884,40 @@ static void gst_defocus_class_init(GstDefocusClass* klass)
     gobject->get_property = getProperty;
     gobject->finalize = finalize;
 
-    // Ranges and defaults are the command line's (`defocus --help`).
+    // Ranges are the command line's, from the library's one definition of them (defocus::limits);
+    // defaults are the library's (defocus::Settings), as the command line's are.
+    namespace limits = defocus::limits;
+    const defocus::Settings defaults;
     installDouble(gobject, PROP_FOCUS, "focus",
-                  "Distance in focus, metres ('inf' for infinity); setting it turns autofocus off", 0.001, INFINITY,
-                  2.0, kControllable);
+                  "Distance in focus, metres ('inf' for infinity); setting it turns autofocus off", limits::kFocusM[0],
+                  limits::kFocusM[1], defaults.lens.focusM, kControllable);
     g_object_class_install_property(
         gobject, PROP_AUTOFOCUS,
         g_param_spec_boolean("autofocus", "autofocus",
-                             "Follow the depth of the centre of the frame (a critically damped spring in dioptres); "
-                             "off: the focus property",
+                             "Follow the depth of the centre of the frame, frame by frame (the command line's "
+                             "--focus track: a critically damped spring in dioptres); off: the focus property",
                              TRUE, kFlags));
     installDouble(gobject, PROP_AUTOFOCUS_TIME_CONSTANT, "autofocus-time-constant",
-                  "Autofocus time constant, seconds (a step is 95 % done after 4.7 of them; 0 jumps)", 0.0, 10.0, 0.25);
-    installDouble(gobject, PROP_F_NUMBER, "f-number", "Aperture as an f-number N (smaller = more blur)", 0.7, 64.0,
-                  2.0, kControllable);
-    installDouble(gobject, PROP_FOCAL_LENGTH, "focal-length", "Lens focal length, millimetres", 1.0, 1200.0, 50.0,
-                  kControllable);
-    installDouble(gobject, PROP_SENSOR_WIDTH, "sensor-width", "Sensor width the image spans, millimetres", 1.0, 100.0,
-                  36.0, kControllable);
+                  "Autofocus time constant, seconds (a step is 95 % done after 4.7 of them; 0 jumps)",
+                  limits::kTimeConstantS[0], limits::kTimeConstantS[1], defaults.autofocus.timeConstantS);
+    installDouble(gobject, PROP_F_NUMBER, "f-number", "Aperture as an f-number N (smaller = more blur)",
+                  limits::kFNumber[0], limits::kFNumber[1], defaults.lens.fNumber, kControllable);
+    installDouble(gobject, PROP_FOCAL_LENGTH, "focal-length", "Lens focal length, millimetres",
+                  limits::kFocalLengthMm[0], limits::kFocalLengthMm[1], defaults.lens.focalLengthMm, kControllable);
+    installDouble(gobject, PROP_SENSOR_WIDTH, "sensor-width", "Sensor width the image spans, millimetres",
+                  limits::kSensorWidthMm[0], limits::kSensorWidthMm[1], defaults.lens.sensorWidthMm, kControllable);
     g_object_class_install_property(
         gobject, PROP_FOV_FROM,
         g_param_spec_enum("fov-from", "fov-from", "Where the sensor width spans the image", fovFromType(), 0, kFlags));
-    installDouble(gobject, PROP_MAX_COC, "max-coc", "Largest blur diameter, pixels", 0.0, 512.0, 32.0, kControllable);
+    installDouble(gobject, PROP_MAX_COC, "max-coc", "Largest blur diameter, pixels", limits::kMaxCocPx[0],
+                  limits::kMaxCocPx[1], defaults.lens.maxCocPx, kControllable);
     g_object_class_install_property(
         gobject, PROP_COC_MODEL,
         g_param_spec_enum("coc-model", "coc-model", "How depth becomes blur", cocModelType(), 0, kFlags));
-    installDouble(gobject, PROP_NEAR, "near", "focal-range model: metres where near blur reaches max-coc", 0.0,
-                  G_MAXDOUBLE, 1.0, kControllable);
-    installDouble(gobject, PROP_FAR, "far", "focal-range model: metres where far blur reaches max-coc", 0.0, INFINITY,
-                  6.0, kControllable);
+    installDouble(gobject, PROP_NEAR, "near", "focal-range model: metres where near blur reaches max-coc",
+                  limits::kNearFarM[0], limits::kNearFarM[1], defaults.lens.nearM, kControllable);
+    installDouble(gobject, PROP_FAR, "far", "focal-range model: metres where far blur reaches max-coc",
+                  limits::kNearFarM[0], limits::kNearFarM[1], defaults.lens.farM, kControllable);
     g_object_class_install_property(
         gobject, PROP_QUALITY,
         g_param_spec_enum("quality", "quality",
@@ -719,8 +926,8 @@ static void gst_defocus_class_init(GstDefocusClass* klass)
                           qualityType(), 1, kFlags));
     g_object_class_install_property(
         gobject, PROP_SAMPLES,
-        g_param_spec_int("samples", "samples", "Taps per directional blur, 2..64; 0 = the quality preset's", 0, 64, 0,
-                         kFlags));
+        g_param_spec_int("samples", "samples", "Taps per directional blur, 2..64; 0 = the quality preset's", 0,
+                         limits::kSamples[1], 0, kFlags));
     g_object_class_install_property(
         gobject, PROP_HEXAGON,
         g_param_spec_enum("hexagon", "hexagon", "How the blurs make the hexagon", hexagonType(), 0, kFlags));
@@ -741,12 +948,14 @@ static void gst_defocus_class_init(GstDefocusClass* klass)
         g_param_spec_boolean("highlight-sprites", "highlight-sprites",
                              "Rhombi: lights brighter than white scatter as hexagons with exact edges", TRUE, kFlags));
     installDouble(gobject, PROP_HIGHLIGHT_GAIN, "highlight-gain",
-                  "Scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off)", 1.0, 64.0, 1.0);
+                  "Scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off)",
+                  limits::kHighlightGain[0], limits::kHighlightGain[1], defaults.quality.highlightGain);
     installDouble(gobject, PROP_BLADE_ROTATION, "blade-rotation",
-                  "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top, 30 = flat top", -180.0, 180.0, 0.0,
+                  "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top, 30 = flat top",
+                  limits::kBladeRotationDeg[0], limits::kBladeRotationDeg[1], defaults.lens.bladeRotationDeg,
                   kControllable);
     installDouble(gobject, PROP_DEPTH_SCALE, "depth-scale", "Units per metre of the 16-bit depth (TUM RGB-D: 5000)",
-                  1e-3, G_MAXDOUBLE, 1000.0);
+                  limits::kDepthScale[0], limits::kDepthScale[1], defaults.depthScale);
     g_object_class_install_property(
         gobject, PROP_VIEW,
         g_param_spec_enum("view", "view", "What to output", viewType(), 4, kFlags));
@@ -767,24 +976,28 @@ static void gst_defocus_class_init(GstDefocusClass* klass)
 
     agg->create_new_pad = createNewPad;
     agg->sink_query = sinkQuery;
+    agg->sink_event = sinkEvent;
+    agg->negotiated_src_caps = negotiatedSrcCaps;
     agg->update_src_caps = updateSrcCaps;
     agg->fixate_src_caps = fixateSrcCaps;
     agg->flush = flush;
     agg->stop = stop;
-    vagg->create_output_buffer = createOutputBuffer;
-    vagg->aggregate_frames = aggregateFrames;
+    agg->aggregate = aggregate;
     vagg->find_best_format = nullptr;
 }
 
 static void gst_defocus_init(GstDefocus* self)
 {
     self->state = new State;
-    // The command line's default focus is automatic; a live stream follows it.
+    // Autofocus by default, as the command line's focus is automatic by default; in a stream
+    // (often live, of a scene that changes) it follows the focus frame by frame, as `--focus
+    // track` does, rather than fixing it at the first frame as `--focus auto` does.
     self->state->settings.autofocus.mode = defocus::AutofocusOptions::Mode::Follow;
 }
 
 static gboolean plugin_init(GstPlugin* plugin)
 {
+    defocus::gst::takeLibraryLog();
     return gst_element_register(plugin, "defocus", GST_RANK_NONE, GST_TYPE_DEFOCUS) &&
            gst_element_register(plugin, "defocussrc", GST_RANK_NONE, GST_TYPE_DEFOCUS_SRC);
 }
@@ -792,4 +1005,4 @@ static gboolean plugin_init(GstPlugin* plugin)
 #define PACKAGE "defocus"
 GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, defocus,
                   "Depth of field with hexagonal bokeh for colour + depth video", plugin_init, DEFOCUS_VERSION,
-                  "unknown", "defocus", "https://github.com/defocus/defocus")
+                  "LGPL", "defocus", "the defocus source tree (no public URL)")

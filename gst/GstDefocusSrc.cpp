@@ -1,11 +1,14 @@
 // The GStreamer element `defocussrc`: what `defocus INPUT --depth DEPTH` reads (TUM folders named
 // by timestamp, folder pairs, a colour camera with a Z16 depth camera, ...) as two src pads, `color`
 // (BGR) and `depth` (GRAY16_LE in depth-scale units per metre), one buffer on each per frame with
-// the same timestamp. Through libdefocus' public defocus::Source; one streaming thread pushes both.
+// the same timestamp and duration: recorded capture times at a variable rate (framerate=0/1, each
+// buffer lasting until the next), frame / rate at a constant one. Through libdefocus' public
+// defocus::Source; one streaming thread pushes both.
 //   gst-launch-1.0 defocussrc location=data/tum_fr1_rpy depth-scale=5000 name=s
 //     defocus name=d focus=1.2 f-number=1.4 depth-scale=5000 ! videoconvert ! autovideosink
 //     s.color ! queue ! d.color  s.depth ! queue ! d.depth                 (one line)
 #include "gst/GstDefocusSrc.hpp"
+#include "gst/LibraryLog.hpp"
 
 #include <cmath>
 #include <memory>
@@ -39,6 +42,13 @@ struct SrcState {
     std::unique_ptr<defocus::Source> source;
     bool live = false;
     std::optional<defocus::SourceFrame> first; ///< read at start, to fix the caps
+    /// Variable rate (the input's own timestamps): the frame after the one being pushed, read
+    /// ahead for its timestamp, which ends the pushed one; and an error met reading it.
+    bool variable = false;
+    std::optional<defocus::SourceFrame> ahead;
+    std::optional<std::string> aheadError;
+    bool aheadEnded = false; ///< reading ahead found the end
+    GstClockTime lastDuration = GST_CLOCK_TIME_NONE;
     bool started = false;                      ///< stream-start, caps and segment sent
     gint64 pushed = 0;
     double firstTimestampS = 0.0;
@@ -158,6 +168,7 @@ void loop(gpointer data)
 {
     auto* self = GST_DEFOCUS_SRC(data);
     SrcState& st = stateOf(self);
+    const defocus::gst::LibraryCall call(GST_ELEMENT(self));
     std::optional<defocus::SourceFrame> frame;
     double scale = 1000.0;
     gint64 limit = -1;
@@ -171,6 +182,12 @@ void loop(gpointer data)
             frame.reset();
         else if (st.first)
             frame = std::exchange(st.first, std::nullopt);
+        else if (st.ahead)
+            frame = std::exchange(st.ahead, std::nullopt);
+        else if (st.aheadError)
+            throw defocus::SourceReadError(*st.aheadError);
+        else if (st.aheadEnded)
+            frame.reset();
         else
             frame = st.source->next();
     } catch (const defocus::Error& error) {
@@ -195,8 +212,12 @@ void loop(gpointer data)
     }
 
     if (!st.started) {
+        // Recorded capture times (TUM lists, files named by timestamp) are never evenly spaced:
+        // variable rate, each buffer lasting until the next one's time. Otherwise the input's rate.
+        st.variable = !st.live && frame->timestampS > 0.0;
         gint num = 0, den = 1;
-        rateFraction(st.source->frameRate(), num, den);
+        if (!st.variable)
+            rateFraction(st.source->frameRate(), num, den);
         gst_video_info_set_format(&st.colorInfo, GST_VIDEO_FORMAT_BGR, static_cast<guint>(frame->color.cols),
                                   static_cast<guint>(frame->color.rows));
         const cv::Size depthSize = frame->depth.empty() ? frame->color.size() : frame->depth.size();
@@ -240,8 +261,26 @@ void loop(gpointer data)
             pts = now > base ? now - base : 0;
             gst_object_unref(clock);
         }
-    } else if (frame->timestampS > 0.0 && st.firstTimestampS > 0.0) {
-        pts = static_cast<GstClockTime>(std::llround((frame->timestampS - st.firstTimestampS) * GST_SECOND));
+    } else if (st.variable) {
+        const auto ptsOf = [&st](const defocus::SourceFrame& f) {
+            return static_cast<GstClockTime>(std::llround(std::max(0.0, f.timestampS - st.firstTimestampS) * GST_SECOND));
+        };
+        pts = ptsOf(*frame);
+        if (!st.ahead && !st.aheadError && !st.aheadEnded && (limit < 0 || st.pushed + 1 < limit)) {
+            try {
+                st.ahead = st.source->next();
+                st.aheadEnded = !st.ahead;
+            } catch (const defocus::Error& error) {
+                st.aheadError = error.what(); // reported after this frame
+            }
+        }
+        if (st.ahead && ptsOf(*st.ahead) > pts)
+            duration = ptsOf(*st.ahead) - pts;
+        else if (GST_CLOCK_TIME_IS_VALID(st.lastDuration))
+            duration = st.lastDuration; // the last frame: as long as the one before
+        else if (st.source->frameRate() > 0.0)
+            duration = static_cast<GstClockTime>(std::llround(GST_SECOND / st.source->frameRate()));
+        st.lastDuration = duration;
     } else {
         pts = GST_CLOCK_TIME_IS_VALID(duration) ? static_cast<GstClockTime>(st.pushed) * duration
                                                 : static_cast<GstClockTime>(st.pushed) * (GST_SECOND / 30);
@@ -284,6 +323,7 @@ bool openSource(GstDefocusSrc* self)
         settings.height = st.height;
         settings.fps = st.fps;
     }
+    const defocus::gst::LibraryCall call(GST_ELEMENT(self));
     if (settings.input.empty()) {
         GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("defocussrc: no location given (a TUM folder, image folder, "
                                                       "image, video file or /dev/videoN)"), (nullptr));
@@ -349,6 +389,10 @@ GstStateChangeReturn changeState(GstElement* element, GstStateChange transition)
         gst_pad_stop_task(self->color);
         st.source.reset();
         st.first.reset();
+        st.ahead.reset();
+        st.aheadError.reset();
+        st.aheadEnded = false;
+        st.lastDuration = GST_CLOCK_TIME_NONE;
         st.started = false;
         break;
     default:
@@ -465,21 +509,22 @@ static void gst_defocus_src_class_init(GstDefocusSrcClass* klass)
         g_param_spec_double("input-depth-scale", "input-depth-scale",
                             "defocus --depth-scale: units per metre of the input's 16-bit depth images; 0 = 5000 "
                             "for TUM folders, 1000 otherwise",
-                            0.0, 1e6, 0.0, kFlags));
+                            0.0, defocus::limits::kDepthScale[1], 0.0, kFlags));
     g_object_class_install_property(
         gobject, PROP_DEPTH_SCALE,
         g_param_spec_double("depth-scale", "depth-scale",
                             "Units per metre of the depth pad's GRAY16_LE (give defocus the same depth-scale)",
-                            1.0, 1e6, 1000.0, kFlags));
+                            defocus::limits::kDepthScale[0], defocus::limits::kDepthScale[1],
+                            defocus::Settings().depthScale, kFlags));
     g_object_class_install_property(gobject, PROP_WIDTH,
-                                    g_param_spec_int("width", "width", "Width asked of a camera, pixels", 1, 16384,
+                                    g_param_spec_int("width", "width", "Width asked of a camera, pixels", 1, G_MAXINT,
                                                      640, kFlags));
     g_object_class_install_property(gobject, PROP_HEIGHT,
                                     g_param_spec_int("height", "height", "Height asked of a camera, pixels", 1,
-                                                     16384, 480, kFlags));
+                                                     G_MAXINT, 480, kFlags));
     g_object_class_install_property(gobject, PROP_FPS,
-                                    g_param_spec_double("fps", "fps", "Frame rate asked of a camera, Hz", 0.1,
-                                                        1000.0, 30.0, kFlags));
+                                    g_param_spec_double("fps", "fps", "Frame rate asked of a camera, Hz",
+                                                        G_MINDOUBLE, G_MAXDOUBLE, 30.0, kFlags));
     g_object_class_install_property(
         gobject, PROP_NUM_BUFFERS,
         g_param_spec_int64("num-buffers", "num-buffers", "Frames to give before the end of stream (-1 = all)", -1,

@@ -90,8 +90,9 @@ std::vector<std::string> check(Settings& settings, bool clamp)
         settings.quality.highlightGain = quality.highlightGain;
     }
 
-    checkRange(issues, "--autofocus-time-constant", settings.autofocus.timeConstantS, 0.0, 10.0, clamp);
-    if (!(settings.depthScale > 0.0) || !std::isfinite(settings.depthScale)) {
+    checkRange(issues, "--autofocus-time-constant", settings.autofocus.timeConstantS, limits::kTimeConstantS[0],
+               limits::kTimeConstantS[1], clamp);
+    if (!(settings.depthScale >= limits::kDepthScale[0] && settings.depthScale <= limits::kDepthScale[1])) {
         issues.push_back(fmt::format("--depth-scale {} must be a positive number of units per metre", settings.depthScale));
         if (clamp)
             settings.depthScale = 1000.0;

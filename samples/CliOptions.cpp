@@ -14,6 +14,7 @@
 
 #include "defocus/Filter.hpp"
 #include "filter/ApiSettings.hpp"
+#include "filter/Log.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
 #include "sources/FrameSource.hpp"
@@ -113,6 +114,15 @@ void logToStderr(std::string_view program, bool quiet, bool verbose)
     spdlog::set_default_logger(logger);
     spdlog::set_pattern(fmt::format("%^{}: %l:%$ %v", program));
     spdlog::set_level(verbose ? spdlog::level::debug : quiet ? spdlog::level::warn : spdlog::level::info);
+    // The library's messages (its static parts linked into this program) the same way.
+    detail::setLogHandler(forwardLibraryLog, LogLevel::Debug);
+}
+
+void forwardLibraryLog(LogLevel level, std::string_view message)
+{
+    constexpr spdlog::level::level_enum kLevels[] = {spdlog::level::debug, spdlog::level::info, spdlog::level::warn,
+                                                     spdlog::level::err};
+    spdlog::default_logger_raw()->log(kLevels[static_cast<int>(level)], "{}", message);
 }
 
 void addCameraOptions(CLI::App& app, SourceOptions& source)

@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "filter/Settings.hpp"
+#include "defocus/Log.hpp"
 #include "defocus/Settings.hpp"
 #include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
@@ -32,13 +33,18 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv);
 /// --version, which prints "PROGRAM VERSION": the project's version, CMake's PROJECT_VERSION.
 void addVersionFlag(CLI::App& app, std::string_view program);
 
-/// Sends every log line (spdlog's default logger) to standard error as "PROGRAM: LEVEL: ...";
-/// standard output keeps only results. quiet: warnings and errors only; verbose: debug too.
+/// Sends every log line (spdlog's default logger, and the library's through forwardLibraryLog) to
+/// standard error as "PROGRAM: LEVEL: ..."; standard output keeps only results. quiet: warnings
+/// and errors only; verbose: debug too.
 void logToStderr(std::string_view program, bool quiet = false, bool verbose = false);
 
 /// A parse error's message; a failed range check (positive, atLeast, between) as a sentence,
 /// "--frames must be at least 1, not 0" where CLI11 writes "--frames: must be ...".
 std::string errorMessage(const CLI::ParseError& error);
+
+/// A defocus::LogHandler that logs the library's message through spdlog's default logger, as the
+/// program's own: defocus::setLogHandler(forwardLibraryLog, LogLevel::Debug) for libdefocus.
+void forwardLibraryLog(LogLevel level, std::string_view message);
 
 /// One line on standard error, "PROGRAM: error: MESSAGE", for use before logToStderr.
 void printError(std::string_view program, std::string_view message);

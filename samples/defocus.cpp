@@ -882,6 +882,7 @@ int main(int argc, char** argv)
     if (const auto status = cli::parse(app, argc, argv))
         return *status;
     cli::logToStderr("defocus", o.quiet, o.verbose);
+    defocus::setLogHandler(cli::forwardLibraryLog, defocus::LogLevel::Debug); // libdefocus' as well
 
     try {
         if (const auto status = checkBatchOptions(app, o))

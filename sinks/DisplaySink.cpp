@@ -15,6 +15,8 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 namespace defocus {
 namespace {
 
@@ -327,7 +329,7 @@ void DisplaySink::poll(int waitMs)
     if (cv::getWindowProperty(options_.title, cv::WND_PROP_VISIBLE) < 1.0) {
         open_ = false;
         controls_.quit = true;
-        spdlog::info("window closed");
+        logger().info("window closed");
     }
 }
 
@@ -339,7 +341,7 @@ void DisplaySink::handleKey(int key)
     }
     const KeyOutcome outcome = applyKey(controls_, key, focusForKeys_);
     if (!outcome.handled) {
-        spdlog::debug("key {} does nothing; keys: {}", key, kKeyHelp);
+        logger().debug("key {} does nothing; keys: {}", key, kKeyHelp);
         return;
     }
     for (const auto& issue : outcome.issues)
@@ -367,9 +369,9 @@ void DisplaySink::onMouse(int event, int x, int y, int, void* self)
 void DisplaySink::note(std::string message, bool warning)
 {
     if (warning)
-        spdlog::warn("{}", message);
+        logger().warn("{}", message);
     else
-        spdlog::info("{}", message);
+        logger().info("{}", message);
     message_ = std::move(message);
     messageWarning_ = warning;
     messageUntil_ = Clock::now() + kMessageTime;

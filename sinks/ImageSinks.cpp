@@ -15,8 +15,8 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
-#include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
 #include "sources/ImageIO.hpp"
 #include "sources/PathNames.hpp"
 
@@ -139,7 +139,7 @@ ImageSequenceSink::~ImageSequenceSink()
     try {
         abandon(false);
     } catch (const std::exception& e) {
-        spdlog::error("{}", e.what());
+        logger().error("{}", e.what());
     }
 }
 
@@ -218,7 +218,7 @@ void ImageSequenceSink::finish()
     std::error_code ec;
     if (written_ == 0) {
         fs::remove_all(work_, ec);
-        spdlog::warn("sequence '{}': no frames written, so nothing written there", folder_.string());
+        logger().warn("sequence '{}': no frames written, so nothing written there", folder_.string());
         return;
     }
     writeLists();
@@ -297,7 +297,7 @@ SingleImageSink::~SingleImageSink()
     try {
         abandon(false);
     } catch (const std::exception& e) {
-        spdlog::error("{}", e.what());
+        logger().error("{}", e.what());
     }
 }
 

@@ -19,6 +19,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 namespace defocus {
 namespace {
 
@@ -146,7 +148,7 @@ void V4l2OutputSink::setFormat(cv::Size size)
     parm.parm.output.timeperframe.numerator = 1000;
     parm.parm.output.timeperframe.denominator = static_cast<std::uint32_t>(std::lround(fps_ * 1000.0));
     if (xioctl(fd_, VIDIOC_S_PARM, &parm) != 0)
-        spdlog::debug("virtual camera {}: VIDIOC_S_PARM {:.3g} fps: {}", dev, fps_, errorText(errno));
+        logger().debug("virtual camera {}: VIDIOC_S_PARM {:.3g} fps: {}", dev, fps_, errorText(errno));
     size_ = size;
 }
 

@@ -16,8 +16,8 @@
 
 #include <fmt/format.h>
 #include <opencv2/videoio/registry.hpp>
-#include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
 #include "sources/PathNames.hpp"
 
 namespace defocus {
@@ -116,7 +116,7 @@ bool withoutTagNotice(Open&& open, bool quiet)
             char line[4096];
             while (std::fgets(line, sizeof line, caught)) {
                 if (quiet && isLibraryLine(line))
-                    spdlog::debug("{}", std::string_view(line).substr(0, std::strcspn(line, "\n")));
+                    logger().debug("{}", std::string_view(line).substr(0, std::strcspn(line, "\n")));
                 else if (!isTagNotice(line))
                     std::fputs(line, stderr);
             }
@@ -170,14 +170,14 @@ VideoSink::VideoSink(fs::path file, double fps, const std::string& codec) : file
             codecName_ = candidate;
             break;
         }
-        spdlog::debug("video '{}': codec {} ({}) does not open here", file_.string(), candidate, fourcc);
+        logger().debug("video '{}': codec {} ({}) does not open here", file_.string(), candidate, fourcc);
     }
     if (codec_.empty())
         throw SinkError(fmt::format("cannot write video '{}': no encoder opens for codec {} in a {} file "
                                     "(OpenCV's FFmpeg lacks it, or the container cannot hold it)",
                                     file_.string(), joined(codecs), ext));
     if (codecName_ != codecs.front())
-        spdlog::warn("video '{}': codec {} unavailable, using {}", file_.string(), codecs.front(), codecName_);
+        logger().warn("video '{}': codec {} unavailable, using {}", file_.string(), codecs.front(), codecName_);
 }
 
 VideoSink::~VideoSink()
@@ -185,7 +185,7 @@ VideoSink::~VideoSink()
     try {
         abandon(false);
     } catch (const std::exception& e) {
-        spdlog::error("{}", e.what());
+        logger().error("{}", e.what());
     }
 }
 
@@ -200,7 +200,7 @@ bool VideoSink::openWriter(cv::VideoWriter& writer, const std::string& fourcc, c
                                cv::VideoWriter::fourcc(fourcc[0], fourcc[1], fourcc[2], fourcc[3]), fps_, size, true);
         }, probe);
     } catch (const cv::Exception& e) {
-        spdlog::debug("video '{}': {} failed to open: {}", file_.string(), fourcc, e.err);
+        logger().debug("video '{}': {} failed to open: {}", file_.string(), fourcc, e.err);
         return false;
     }
 }
@@ -221,7 +221,7 @@ void VideoSink::write(const cv::Mat& image)
                                         file_.string(), codec_, image.cols, image.rows));
         size_ = image.size();
         if (size_.width % 2 != 0 || size_.height % 2 != 0)
-            spdlog::warn("video '{}': frames are {}x{}; codecs with 4:2:0 chroma store {}x{}",
+            logger().warn("video '{}': frames are {}x{}; codecs with 4:2:0 chroma store {}x{}",
                          file_.string(), size_.width, size_.height, size_.width & ~1,
                          size_.height & ~1);
     } else if (image.size() != size_) {
@@ -243,7 +243,7 @@ void VideoSink::finish()
     std::error_code ec;
     if (written_ == 0) {
         fs::remove(partial_, ec);
-        spdlog::warn("video '{}': no frames written, so no file created", file_.string());
+        logger().warn("video '{}': no frames written, so no file created", file_.string());
         return;
     }
     fs::rename(partial_, file_, ec);

@@ -11,6 +11,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 #include "sources/ImageIO.hpp"
 #include "sources/PathNames.hpp"
 
@@ -61,7 +63,7 @@ FolderPairSource::FolderPairSource(fs::path colorFolder, std::optional<fs::path>
             colorFolder_.string()));
     std::error_code ec;
     if (!depth_) {
-        spdlog::warn("image folder '{}': no depth given; its {} frames pass through in focus",
+        logger().warn("image folder '{}': no depth given; its {} frames pass through in focus",
                      colorFolder_.string(), colorFiles_.size());
     } else if (fs::is_directory(*depth_, ec)) {
         depthFiles_ = listImages(*depth_);

@@ -6,8 +6,8 @@
 #include <system_error>
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
 #include "sources/FolderPairSource.hpp"
 #include "sources/PathNames.hpp"
 #include "sources/SingleImageSource.hpp"
@@ -72,7 +72,7 @@ std::unique_ptr<FrameSource> openSource(const SourceOptions& options)
         const double scale = options.depthScale.value_or(defaultUnitsPerMetre);
         if (isVideoFile(input)) {
             if (!options.depth) // a depth folder or depth.txt went to openStreamSource
-                spdlog::warn("video '{}': no depth given; its frames pass through in focus", input.string());
+                logger().warn("video '{}': no depth given; its frames pass through in focus", input.string());
             return std::make_unique<VideoFileSource>(input, options.depth, scale);
         }
         if (options.depth && fs::is_directory(*options.depth, ec))

@@ -15,6 +15,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 #include "sources/ImageIO.hpp"
 #include "sources/PathNames.hpp"
 #include "sources/TumLists.hpp"
@@ -255,7 +257,7 @@ PairedSource::PairedSource(std::unique_ptr<FrameSource> color, std::unique_ptr<D
     const std::optional<std::size_t> colorCount = color_->frameCount();
     if (sequence && sequence->pairing().mode == DepthPairing::Mode::Index && colorCount &&
         *colorCount != *sequence->count())
-        spdlog::warn("{} colour frames and {} depth images ({}): paired by index, {}", *colorCount,
+        logger().warn("{} colour frames and {} depth images ({}): paired by index, {}", *colorCount,
                      *sequence->count(), depth_->describe(),
                      *colorCount > *sequence->count() ? "the frames past the last depth pass through in focus"
                                                       : "the extra depth images are not used");
@@ -274,7 +276,7 @@ std::optional<Frame> PairedSource::next()
     } else {
         frame->depth.release();
         if (unpaired_ == 0)
-            spdlog::warn("{}: no depth pairs with colour frame {}; frames without depth pass through "
+            logger().warn("{}: no depth pairs with colour frame {}; frames without depth pass through "
                          "in focus", depth_->describe(), frame->name);
         ++unpaired_;
     }

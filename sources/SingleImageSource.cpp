@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 #include "sources/ImageIO.hpp"
 
 namespace defocus {
@@ -23,7 +25,7 @@ SingleImageSource::SingleImageSource(std::filesystem::path colorFile,
         description_ = fmt::format("image '{}' + depth '{}'", colorFile.string(),
                                    depthFile->string());
     } else {
-        spdlog::warn("image '{}': no depth given; it passes through in focus", colorFile.string());
+        logger().warn("image '{}': no depth given; it passes through in focus", colorFile.string());
         description_ = fmt::format("image '{}' (no depth)", colorFile.string());
     }
 }

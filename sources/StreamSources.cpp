@@ -8,6 +8,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 #include "sources/PairedSource.hpp"
 #include "sources/PathNames.hpp"
 #include "sources/V4l2Source.hpp"
@@ -65,7 +67,7 @@ std::unique_ptr<FrameSource> openStreamSource(const SourceOptions& options)
         colour.pixelFormat = options.pixelFormat;
         auto camera = std::make_unique<V4l2Source>(colour);
         if (!options.depth) {
-            spdlog::warn("camera {}: no depth given; its frames pass through in focus",
+            logger().warn("camera {}: no depth given; its frames pass through in focus",
                          options.input.string());
             return camera;
         }

@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 #include "sources/ImageIO.hpp"
 #include "sources/TumLists.hpp"
 
@@ -100,13 +102,13 @@ void TumSource::pairByTimestamp(const fs::path& rgbList, const fs::path& depthLi
         } else {
             if (unpaired++ == 0)
                 firstUnpaired = colour.file.generic_string();
-            spdlog::debug("{}: no depth within {} ms of {}", folder_.string(),
+            logger().debug("{}: no depth within {} ms of {}", folder_.string(),
                           maxPairingGap * 1000.0, colour.file.generic_string());
         }
         entries_.push_back(std::move(entry));
     }
     if (unpaired > 0)
-        spdlog::warn("TUM folder '{}': {} of {} colour frames have no depth within {} ms (first: "
+        logger().warn("TUM folder '{}': {} of {} colour frames have no depth within {} ms (first: "
                      "{}); they pass through in focus",
                      folder_.string(), unpaired, rgb.size(), maxPairingGap * 1000.0,
                      firstUnpaired);

@@ -25,6 +25,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 namespace defocus {
 namespace {
 
@@ -106,7 +108,7 @@ V4l2Source::V4l2Source(V4l2Options options) : options_(std::move(options))
         stopStreaming();
         throw;
     }
-    spdlog::info("{}", describe());
+    logger().info("{}", describe());
 }
 
 V4l2Source::~V4l2Source()
@@ -180,7 +182,7 @@ std::uint32_t V4l2Source::chooseFormat(const std::vector<std::uint32_t>& offered
                 options_.pixelFormat, depth ? "depth" : "colour",
                 depth ? "Z16" : "YUYV, NV12, RGB3, BGR3, GREY, MJPG"));
         if (!contains(offered, asked))
-            spdlog::warn("camera {}: does not list {} (it lists {}); asking for it anyway", dev,
+            logger().warn("camera {}: does not list {} (it lists {}); asking for it anyway", dev,
                          v4l2::fourccName(asked), formatList(offered));
         return asked;
     }
@@ -239,7 +241,7 @@ std::uint32_t V4l2Source::chooseFormat(const std::vector<std::uint32_t>& offered
         }
     }
     if (fallback) {
-        spdlog::warn("camera {}: no format reaches {:.3g} Hz at {}x{}; {} is the fastest at {:.3g} Hz",
+        logger().warn("camera {}: no format reaches {:.3g} Hz at {}x{}; {} is the fastest at {:.3g} Hz",
                      dev, options_.fps, options_.width, options_.height,
                      v4l2::fourccName(*fallback), fallbackRate);
         return *fallback;
@@ -283,7 +285,7 @@ void V4l2Source::setFormat(std::uint32_t fourcc, const std::vector<std::uint32_t
             throw SourceError(fmt::format("camera {} ({}): asked for {}, the driver gave {}, which "
                                           "defocus does not decode", dev, card_,
                                           v4l2::fourccName(fourcc), v4l2::fourccName(got.pixelformat)));
-        spdlog::warn("camera {}: asked for {}, the driver gave {}; reading {}", dev,
+        logger().warn("camera {}: asked for {}, the driver gave {}; reading {}", dev,
                      v4l2::fourccName(fourcc), v4l2::fourccName(got.pixelformat),
                      v4l2::fourccName(got.pixelformat));
     }
@@ -291,10 +293,10 @@ void V4l2Source::setFormat(std::uint32_t fourcc, const std::vector<std::uint32_t
         throw SourceError(fmt::format("camera {}: the driver set an unusable size {}x{}", dev,
                                       got.width, got.height));
     if (got.width != static_cast<__u32>(options_.width) || got.height != static_cast<__u32>(options_.height))
-        spdlog::info("camera {}: asked for {}x{}, the driver gives {}x{}", dev, options_.width,
+        logger().info("camera {}: asked for {}x{}, the driver gives {}x{}", dev, options_.width,
                      options_.height, got.width, got.height);
     if (got.field != V4L2_FIELD_NONE && got.field != V4L2_FIELD_ANY)
-        spdlog::warn("camera {}: the driver delivers interlaced frames (field order {}); they are "
+        logger().warn("camera {}: the driver delivers interlaced frames (field order {}); they are "
                      "read as progressive", dev, got.field);
     layout_ = {got.pixelformat, static_cast<int>(got.width), static_cast<int>(got.height),
                got.bytesperline};
@@ -309,7 +311,7 @@ void V4l2Source::setFormat(std::uint32_t fourcc, const std::vector<std::uint32_t
     if (yuv && got.priv == V4L2_PIX_FMT_PRIV_MAGIC &&
         (got.quantization == V4L2_QUANTIZATION_FULL_RANGE ||
          (got.ycbcr_enc != V4L2_YCBCR_ENC_DEFAULT && got.ycbcr_enc != V4L2_YCBCR_ENC_601)))
-        spdlog::warn("camera {}: the driver encodes {} with Y'CbCr encoding {} and quantization {}; "
+        logger().warn("camera {}: the driver encodes {} with Y'CbCr encoding {} and quantization {}; "
                      "defocus reads BT.601 limited range, so colours will be slightly off", dev,
                      v4l2::fourccName(got.pixelformat), got.ycbcr_enc, got.quantization);
 }
@@ -327,13 +329,13 @@ void V4l2Source::setFrameRate()
             static_cast<__u32>(std::lround(options_.fps * 1000.0));
         set = xioctl(fd_, VIDIOC_S_PARM, &parm) == 0;
         if (!set)
-            spdlog::warn("camera {}: VIDIOC_S_PARM failed ({}); capturing at the driver's rate",
+            logger().warn("camera {}: VIDIOC_S_PARM failed ({}); capturing at the driver's rate",
                          options_.device.string(), errorText(errno));
         // S_PARM returns the interval the driver set; read it again in case it did not.
         if (xioctl(fd_, VIDIOC_G_PARM, &parm) != 0)
             parm.parm.capture.timeperframe = {};
     } else {
-        spdlog::info("camera {}: the driver does not set frame rates; capturing at its own rate",
+        logger().info("camera {}: the driver does not set frame rates; capturing at its own rate",
                      options_.device.string());
     }
     const v4l2_fract t = parm.parm.capture.timeperframe;
@@ -341,7 +343,7 @@ void V4l2Source::setFrameRate()
                      ? static_cast<double>(t.denominator) / t.numerator
                      : options_.fps;
     if (set && std::abs(frameRate_ - options_.fps) > 0.01 * options_.fps)
-        spdlog::info("camera {}: asked for {:.3g} Hz, the driver gives {:.3g} Hz",
+        logger().info("camera {}: asked for {:.3g} Hz, the driver gives {:.3g} Hz",
                      options_.device.string(), options_.fps, frameRate_);
 }
 
@@ -359,7 +361,7 @@ void V4l2Source::startStreaming()
         throw SourceError(fmt::format("camera {} ({}): the driver gave {} buffer(s); streaming "
                                       "needs at least 2", dev, card_, request.count));
     if (request.count < 3)
-        spdlog::warn("camera {}: the driver gave only {} buffers; frames may be dropped", dev,
+        logger().warn("camera {}: the driver gave only {} buffers; frames may be dropped", dev,
                      request.count);
     for (__u32 i = 0; i < request.count; ++i) {
         v4l2_buffer buffer{};
@@ -464,7 +466,7 @@ bool V4l2Source::dequeue(std::optional<Frame>& frame)
     if (image.empty()) {
         ++dropped_;
         if (warnings_++ < 5)
-            spdlog::warn("camera {}: skipped frame {}: {}", dev, buffer.sequence, problem);
+            logger().warn("camera {}: skipped frame {}: {}", dev, buffer.sequence, problem);
         return true;
     }
 

@@ -10,6 +10,8 @@
 #include <opencv2/videoio/registry.hpp>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 #include "sources/ImageIO.hpp"
 
 namespace defocus {
@@ -64,7 +66,7 @@ std::optional<Frame> VideoFileSource::next()
         ended_ = true;
         capture_.release();
         if (frameCount_ && next_ < *frameCount_)
-            spdlog::warn("video '{}': decoding stopped after {} of the {} frames its header states; "
+            logger().warn("video '{}': decoding stopped after {} of the {} frames its header states; "
                          "the file is truncated or damaged, and the frames written so far are kept",
                          file_.string(), next_, *frameCount_);
         return std::nullopt;

@@ -20,6 +20,7 @@
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/ImageHeader.hpp"
 #include "sources/ImageIO.hpp"
@@ -100,23 +101,27 @@ std::vector<std::string> fileNames(const fs::path& dir)
 
 #define EXPECT_CONTAINS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
 
-/// Collects what spdlog logs while it lives.
+/// Collects what the library logs (its own logger) and the program (spdlog's default) while it lives.
 class LogCapture {
 public:
     LogCapture() : sink_(std::make_shared<spdlog::sinks::ostream_sink_mt>(stream_))
     {
-        spdlog::default_logger()->sinks().push_back(sink_);
+        for (spdlog::logger* logger : loggers())
+            logger->sinks().push_back(sink_);
     }
     ~LogCapture()
     {
-        auto& sinks = spdlog::default_logger()->sinks();
-        sinks.erase(std::remove(sinks.begin(), sinks.end(), sink_), sinks.end());
+        for (spdlog::logger* logger : loggers()) {
+            auto& sinks = logger->sinks();
+            sinks.erase(std::remove(sinks.begin(), sinks.end(), sink_), sinks.end());
+        }
     }
     LogCapture(const LogCapture&) = delete;
     LogCapture& operator=(const LogCapture&) = delete;
     std::string text() const { return stream_.str(); }
 
 private:
+    static std::vector<spdlog::logger*> loggers() { return {spdlog::default_logger_raw(), &defocus::logger()}; }
     std::ostringstream stream_;
     std::shared_ptr<spdlog::sinks::ostream_sink_mt> sink_;
 };

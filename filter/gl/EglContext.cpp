@@ -14,6 +14,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
+
 namespace defocus::gl {
 
 namespace {
@@ -100,9 +102,9 @@ void GLAPIENTRY logGlMessage(GLenum, GLenum type, GLuint, GLenum severity, GLsiz
     if (severity == GL_DEBUG_SEVERITY_NOTIFICATION)
         return;
     if (type == GL_DEBUG_TYPE_ERROR)
-        spdlog::error("GL: {}", message);
+        logger().error("GL: {}", message);
     else
-        spdlog::debug("GL: {}", message);
+        logger().debug("GL: {}", message);
 }
 
 // Initialises `display`, binds desktop GL and creates a 4.5 core context on it.
@@ -322,7 +324,7 @@ EglContext EglContext::create(const ContextOptions& options)
         glEnable(GL_DEBUG_OUTPUT);
         glDebugMessageCallback(logGlMessage, nullptr);
     }
-    spdlog::debug("EGL {} platform{}: {} / {}", info.platform,
+    logger().debug("EGL {} platform{}: {} / {}", info.platform,
                   info.device >= 0 ? fmt::format(" (EGL device {})", info.device) : "", info.glRenderer, info.glVersion);
     return context;
 }

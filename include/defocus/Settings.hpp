@@ -3,6 +3,7 @@
 // (`defocus --help`), so `--f-number 1.4` is `settings.lens.fNumber = 1.4`.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -63,7 +64,7 @@ struct AutofocusOptions {
     };
     /// Default Off.
     Mode mode = Mode::Off;
-    /// Follow: the spring's time constant, seconds, [0, 10]; 0 jumps at once. Default 0.25.
+    /// Follow: the spring's time constant, seconds, >= 0 and finite; 0 jumps at once. Default 0.25.
     double timeConstantS = 0.25;
 };
 
@@ -128,6 +129,26 @@ struct Settings {
     /// TUM RGB-D uses 5000.
     double depthScale = 1000.0;
 };
+
+/// The range of each setting, {lowest, highest} allowed, as the command line's options, check()
+/// and the GStreamer element's properties take them.
+namespace limits {
+inline constexpr double kFocalLengthMm[] = {1.0, 1200.0};
+inline constexpr double kFNumber[] = {0.7, 64.0};
+inline constexpr double kSensorWidthMm[] = {1.0, 100.0};
+inline constexpr double kMaxCocPx[] = {0.0, 512.0};
+inline constexpr double kBladeRotationDeg[] = {-180.0, 180.0};
+inline constexpr int kSamples[] = {2, 64};
+inline constexpr double kHighlightGain[] = {1.0, 64.0};
+/// Lens::focusM: +inf included; check() also holds it beyond the focal length.
+inline constexpr double kFocusM[] = {kFocalLengthMm[0] * 1e-3, std::numeric_limits<double>::infinity()};
+/// Lens::nearM and Lens::farM: +inf included; check() also holds them either side of the focus.
+inline constexpr double kNearFarM[] = {0.0, std::numeric_limits<double>::infinity()};
+/// AutofocusOptions::timeConstantS: any finite time.
+inline constexpr double kTimeConstantS[] = {0.0, std::numeric_limits<double>::max()};
+/// Settings::depthScale: any positive finite number of units per metre.
+inline constexpr double kDepthScale[] = {std::numeric_limits<double>::min(), std::numeric_limits<double>::max()};
+} // namespace limits
 
 /// Checks every field against its range, with the command line's words: each problem is one
 /// message such as "--f-number must be between 0.7 and 64, not 0.5"; none means valid. With `clamp`, each

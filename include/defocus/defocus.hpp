@@ -1,8 +1,9 @@
 // The whole public API of libdefocus: find_package(defocus) + target defocus::defocus, or
 // pkg-config defocus. See Filter.hpp for the filter, Settings.hpp for what it takes and Source.hpp
-// for reading the inputs the command line reads.
+// for reading the inputs the command line reads, Log.hpp for where its messages go.
 #pragma once
 
 #include "defocus/Filter.hpp"
+#include "defocus/Log.hpp"
 #include "defocus/Settings.hpp"
 #include "defocus/Source.hpp"
