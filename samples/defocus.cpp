@@ -6,9 +6,10 @@
 // which opens the input and output and hands them to processClip. The settings and the filtering
 // go through the library's public API (defocus::Settings, defocus::Filter, include/defocus/): one
 // Filter, its GL context and shaders, is made once and serves several clips (--batch). The
-// command line's parsing (CLI11), // the sources and the sinks are the tree's own, and so is the focus control (FocusSchedule, over
-// the pipeline's Autofocus) and --demo's synthetic source (which takes the pipeline's lens type). Results go to standard output, diagnostics to standard error;
-// the exit statuses are ExitStatus.hpp's.
+// command line's parsing (CLI11), the sources and the sinks are the tree's own, and so is the
+// focus control (FocusSchedule, over the pipeline's Autofocus) and --demo's synthetic source
+// (which takes the pipeline's lens type and renders in a GL context of its own). Results go to
+// standard output, diagnostics to standard error; the exit statuses are ExitStatus.hpp's.
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -31,6 +32,7 @@
 #include "defocus/Filter.hpp"
 #include "defocus/Settings.hpp"
 #include "filter/ApiSettings.hpp"
+#include "filter/gl/EglContext.hpp"
 #include "samples/Batch.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
@@ -502,13 +504,30 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
     if (!options.timings.empty())
         refuseExisting(options.timings, options.overwrite);
 
+    // --demo renders its frames with GL in a context of its own, current on this thread for the
+    // whole run (the Filter binds its own for each call and puts this one back); declared before
+    // the source, so that it outlives it. It shares its EGL display with the filter's context but
+    // not the count of the display's users (libdefocus holds its own copy of the GL code), so the
+    // filter ends first, with the demo: the display is terminated once, by the last to end.
+    std::optional<gl::EglContext> demoContext;
+    struct EndFilterFirst {
+        std::optional<Filter>& filter;
+        const std::optional<gl::EglContext>& context;
+        ~EndFilterFirst()
+        {
+            if (context)
+                filter.reset();
+        }
+    } endFilterFirst{filter, demoContext};
     std::unique_ptr<FrameSource> source;
     SyntheticSource* demo = nullptr;
     if (options.demo) {
-        // --demo renders its frames with GL in the context that is current on this thread: the
-        // filter's, so the filter comes first (Filter.hpp: its context stays current here).
         if (!filter)
             filter.emplace(Settings{}, contextOptions(options));
+        gl::ContextOptions demoOptions;
+        if (options.eglDevice)
+            demoOptions.device = *options.eglDevice;
+        demoContext.emplace(gl::EglContext::create(demoOptions));
         auto synthetic = openDemo(options);
         demo = synthetic.get();
         source = std::move(synthetic);
