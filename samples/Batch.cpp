@@ -404,6 +404,20 @@ nlohmann::json schedulerInfo()
     return slurm;
 }
 
+/// The folder a clip's output goes into (the parent of a file, or of a folder output), made with
+/// the folders above it: a manifest is a deliberate list, often of outputs in folders not made yet
+/// (one per scene, per camera), where the command line's "no missing path is made" would only make
+/// every clip fail. A folder output's own folder is its sink's to make.
+void makeOutputFolder(const Clip& clip)
+{
+    const fs::path output = clip.output.has_filename() ? clip.output : clip.output.parent_path();
+    const fs::path folder = output.parent_path();
+    std::error_code error;
+    if (!folder.empty() && !fs::is_directory(folder, error) && !fs::create_directories(folder, error) && error)
+        throw std::runtime_error(
+            fmt::format("cannot make the folder '{}' for '{}': {}", folder.string(), clip.outputAsWritten, error.message()));
+}
+
 } // namespace
 
 int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
@@ -446,6 +460,7 @@ int runBatch(const std::vector<Clip>& clips, const BatchOptions& options,
             const auto start = std::chrono::steady_clock::now();
             ClipOutcome outcome;
             try {
+                makeOutputFolder(clip);
                 outcome = run(clip);
             } catch (const std::exception& error) {
                 spdlog::error("{}", error.what()); // the runner said nothing of it

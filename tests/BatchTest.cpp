@@ -248,10 +248,11 @@ struct FakeBatch {
                     ClipOutcome outcome;
                     const auto found = statusOf.find(clip.index);
                     outcome.status = found == statusOf.end() ? 0 : found->second;
-                    if (outcome.status == 0) {
-                        fs::create_directories(clip.output.parent_path());
+                    const fs::path output = clip.output.has_filename() ? clip.output : clip.output.parent_path();
+                    if (!fs::is_directory(output.parent_path()))
+                        outcome.status = 1; // as the sinks refuse an output whose folder is missing
+                    if (outcome.status == 0)
                         std::ofstream(clip.output) << "frames";
-                    }
                     if (outcome.status == 143)
                         stop = 143; // as the signal handler would
                     outcome.report["frames_out"] = 3;
@@ -347,6 +348,18 @@ TEST(RunBatch, ClipsThatFailedAreTriedAgainByARerunUntilDone)
     batch.runs = 0;
     EXPECT_EQ(batch.run(), 0);
     EXPECT_EQ(batch.runs, 0) << "all done: nothing to do";
+}
+
+// Defect: a manifest whose outputs go into folders not made yet (out/scene3/clip.mp4) failing every
+// clip, as the command line refuses a missing folder; the batch makes the folders it names.
+TEST(RunBatch, TheFoldersAManifestNamesAreMade)
+{
+    FakeBatch batch("BatchRunFolders", 1);
+    std::istringstream in("in0\t-\tout/scene/a/clip.mp4\nin1\t-\tout/scene/b/frames/\n");
+    batch.clips = parseManifest(in, "m.tsv", batch.dir);
+    EXPECT_EQ(batch.run(), 0);
+    EXPECT_TRUE(fs::is_regular_file(batch.dir / "out/scene/a/clip.mp4"));
+    EXPECT_TRUE(fs::is_directory(batch.dir / "out/scene/b"));
 }
 
 // Defect: --jobs 2 running one clip at a time, or two workers taking the same clip.
