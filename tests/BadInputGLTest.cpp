@@ -98,11 +98,12 @@ TEST_F(BadInputCliGLTest, BrokenFrameMidClipLeavesTheEarlierOutputUntouched)
     std::ofstream(out / "tb" / "rgb.txt") << "# an earlier good sequence\n1.0 1.png\n";
     std::ofstream(out / "tb" / "1.png") << "an earlier good frame";
     for (const std::string output : {"tb.mp4", "tb/", "tb.png"}) {
-        const CliResult r = runDefocus(fmt::format("'{}' --focus 1 --quality fast -y -o '{}'", clip.string(),
-                                                   (out / output).string()));
+        // One image holds one frame: the broken one, chosen with --start.
+        const std::string frames = output == "tb.png" ? "--start 5 --frames 1 " : "";
+        const CliResult r = runDefocus(fmt::format("'{}' --focus 1 --quality fast {}-y -o '{}'", clip.string(),
+                                                   frames, (out / output).string()));
         EXPECT_EQ(r.exitCode, 1) << output << "\n" << r.output;
-        EXPECT_NE(r.output.find("frame 5: cannot read colour image '" + broken.string()), std::string::npos)
-            << r.output;
+        EXPECT_NE(r.output.find("cannot read colour image '" + broken.string()), std::string::npos) << r.output;
         EXPECT_EQ(fileNames(out), (std::vector<std::string>{"tb", "tb.mp4", "tb.png"})) << output;
         EXPECT_EQ(fileNames(out / "tb"), (std::vector<std::string>{"1.png", "rgb.txt"})) << output;
     }
@@ -119,14 +120,16 @@ TEST_F(BadInputCliGLTest, BrokenFrameMidClipWithKeepPartialKeepsTheFramesBeforeI
     const fs::path clip = tumClipWithBrokenFrame5("CliGL_midclip_keep", broken);
     const fs::path out = clip.parent_path() / "out";
     fs::create_directories(out); // defocus makes no missing folder above a file output
-    for (const std::string output : {"tb.mp4", "tb/", "tb.png"}) {
+    // (A one-image output holds one frame, so no frame comes before a broken one there; the
+    // sinks' test keeps a partial image, FileSinks.AbandonLeavesTheFinalNameAloneAndKeepsThePartialOnlyWhenAsked.)
+    for (const std::string output : {"tb.mp4", "tb/"}) {
         const CliResult r = runDefocus(fmt::format("'{}' --focus 1 --quality fast --keep-partial -o '{}'",
                                                    clip.string(), (out / output).string()));
         EXPECT_EQ(r.exitCode, 1) << output << "\n" << r.output;
         EXPECT_NE(r.output.find("5 frames in, 5 frames out"), std::string::npos) << r.output;
         EXPECT_NE(r.output.find("the frames before the error are in"), std::string::npos) << r.output;
     }
-    EXPECT_EQ(fileNames(out), (std::vector<std::string>{"tb.partial", "tb.partial.mp4", "tb.partial.png"}));
+    EXPECT_EQ(fileNames(out), (std::vector<std::string>{"tb.partial", "tb.partial.mp4"}));
     cv::VideoCapture capture((out / "tb.partial.mp4").string());
     ASSERT_TRUE(capture.isOpened());
     int frames = 0;
@@ -141,7 +144,6 @@ TEST_F(BadInputCliGLTest, BrokenFrameMidClipWithKeepPartialKeepsTheFramesBeforeI
             EXPECT_TRUE(fs::exists(out / "tb.partial" / line.substr(line.find(' ') + 1))) << line;
         }
     EXPECT_EQ(listed, 5);
-    EXPECT_EQ(cv::imread((out / "tb.partial.png").string()).size(), cv::Size(640, 480));
 }
 
 TEST_F(BadInputCliGLTest, BrokenFirstFrameLeavesNoOutputAtAll)

@@ -18,6 +18,7 @@
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/PairedSource.hpp"
 #include "sources/V4l2Formats.hpp"
@@ -235,15 +236,18 @@ SourceOptions optionsFor(fs::path input, std::optional<fs::path> depth = std::nu
     return options;
 }
 
-/// What spdlog logs while `open` runs.
+/// What the library (its own logger) and spdlog's default logger log while `open` runs.
 std::string logOf(const std::function<void()>& open)
 {
     std::ostringstream text;
     const auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text);
-    auto& sinks = spdlog::default_logger()->sinks();
-    sinks.push_back(sink);
+    for (spdlog::logger* logger : {spdlog::default_logger_raw(), &defocus::logger()})
+        logger->sinks().push_back(sink);
     open();
-    sinks.erase(std::remove(sinks.begin(), sinks.end(), sink), sinks.end());
+    for (spdlog::logger* logger : {spdlog::default_logger_raw(), &defocus::logger()}) {
+        auto& sinks = logger->sinks();
+        sinks.erase(std::remove(sinks.begin(), sinks.end(), sink), sinks.end());
+    }
     return text.str();
 }
 
