@@ -28,6 +28,7 @@
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
 #include "samples/LiveLoop.hpp"
+#include "samples/PreviewController.hpp"
 #include "sinks/DisplaySink.hpp"
 #include "sources/DepthScale.hpp"
 #include "sources/FrameSource.hpp"
@@ -109,10 +110,12 @@ int run(const Options& o)
     controls.nearRatio = o.nearM.value_or(controls.nearRatio * rangeFocus) / rangeFocus;
     controls.farRatio = o.farM.value_or(controls.farRatio * rangeFocus) / rangeFocus;
 
+    // What the window's keys and clicks do to the controls.
+    PreviewController controller(controls);
     // The window before the GL context: a missing display is the likelier failure, and cheap.
     std::unique_ptr<DisplaySink> display;
     if (!o.noWindow)
-        display = std::make_unique<DisplaySink>(controls, DisplayOptions{"defocus-preview", o.screenshotDir});
+        display = std::make_unique<DisplaySink>(DisplayOptions{"defocus-preview", o.screenshotDir});
     auto context = gl::EglContext::create();
     Pipeline pipeline;
     if (!o.quiet)
@@ -225,8 +228,10 @@ int run(const Options& o)
             // 3. Render and show when anything changed.
             const bool render = current && (fresh || animating || forceRender || controls.revision != renderedRevision);
             if (!render) {
-                if (display)
+                if (display) {
                     display->poll(live && !controls.paused ? 1 : 15);
+                    controller.serve(*display);
+                }
                 continue;
             }
             forceRender = false;
@@ -268,9 +273,10 @@ int run(const Options& o)
                     status.message = "clamped: " + issueText;
                     status.warning = true;
                 }
-                display->setFocusForKeys(autofocus.focusM());
-                display->setStatus(status, controls.tileMap ? &pipeline.analysis() : nullptr);
+                controller.setFocusForKeys(autofocus.focusM());
+                display->setHud(controller.hud(status, controls.tileMap ? &pipeline.analysis() : nullptr));
                 display->write(image);
+                controller.serve(*display);
             }
             if (fresh) {
                 stats.frameShown(current->origin, LiveClock::now());

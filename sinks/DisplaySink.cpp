@@ -1,11 +1,12 @@
-// The preview window: key and mouse controls, HUD composition and screenshots, on highgui.
+// The preview window on highgui: the frame with its HUD band, the keys and clicks it receives,
+// screenshots.
 #include "sinks/DisplaySink.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <limits>
 #include <system_error>
+#include <utility>
 
 #include <dlfcn.h>
 
@@ -13,69 +14,25 @@
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
 
 #include "filter/Log.hpp"
 
 namespace defocus {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 constexpr int kMinHudWidth = 560;
 constexpr int kLineHeight = 18;
 constexpr double kFontScale = 0.42;
-constexpr auto kMessageTime = std::chrono::seconds(4);
 
-int viewNumber(View view)
+void drawMarks(cv::Mat& picture, const HudMarks& marks)
 {
-    return static_cast<int>(view) + 1;
-}
-
-std::string fNumberText(double n)
-{
-    return n < 10.0 ? fmt::format("{:.1f}", n) : fmt::format("{:.0f}", n);
-}
-
-/// One third of a stop on the standard scale: N = 2^(k/6) (a stop multiplies N by sqrt 2).
-double thirdStop(double n, int direction)
-{
-    const double k = std::round(6.0 * std::log2(n));
-    return std::exp2((k + direction) / 6.0);
-}
-
-std::string rangeText(const LensSettings& lens)
-{
-    if (lens.model == CocModel::ThinLens)
-        return "thin-lens";
-    return fmt::format("focal range {:.2f}-{:.2f} m", lens.nearLimitM, lens.farLimitM);
-}
-
-/// Short GPU pass names so that one line holds them all at 560 px.
-std::string_view shortPassName(std::string_view name)
-{
-    if (name == "horizontal")
-        return "h";
-    if (name == "diagonal-a")
-        return "a";
-    if (name == "diagonal-b")
-        return "b";
-    if (name == "composite")
-        return "comp";
-    if (name == "near-field")
-        return "near";
-    return name;
-}
-
-void drawFocusMarks(cv::Mat& picture, const FocusWindow& window, bool active)
-{
-    const double w = std::max(window.size.width * picture.cols, 3.0);
-    const double h = std::max(window.size.height * picture.rows, 3.0);
-    const cv::Point2d c(window.centre.x * picture.cols, window.centre.y * picture.rows);
+    const double w = std::max(marks.size.width * picture.cols, 3.0);
+    const double h = std::max(marks.size.height * picture.rows, 3.0);
+    const cv::Point2d c(marks.centre.x * picture.cols, marks.centre.y * picture.rows);
     const int x0 = static_cast<int>(std::lround(c.x - w / 2)), x1 = static_cast<int>(std::lround(c.x + w / 2));
     const int y0 = static_cast<int>(std::lround(c.y - h / 2)), y1 = static_cast<int>(std::lround(c.y + h / 2));
     const int arm = std::max(3, static_cast<int>(std::min(w, h) / 4));
-    const cv::Scalar colour = active ? cv::Scalar(90, 230, 90) : cv::Scalar(170, 170, 170);
+    const cv::Scalar colour = marks.active ? cv::Scalar(90, 230, 90) : cv::Scalar(170, 170, 170);
     for (const auto& [thickness, ink] : {std::pair{3, cv::Scalar(0, 0, 0)}, std::pair{1, colour}}) {
         for (const int x : {x0, x1}) {
             const int dx = x == x0 ? arm : -arm;
@@ -88,152 +45,28 @@ void drawFocusMarks(cv::Mat& picture, const FocusWindow& window, bool active)
     }
 }
 
-void drawTileMap(cv::Mat& picture, const SceneAnalysis& analysis)
-{
-    const int s = SceneAnalysis::kTileSize;
-    const cv::Rect bounds(0, 0, picture.cols, picture.rows);
-    for (int y = 0; y < analysis.tiles.height; ++y)
-        for (int x = 0; x < analysis.tiles.width; ++x)
-            if (analysis.tileNeedsBlur(x, y))
-                cv::rectangle(picture, cv::Rect(x * s, y * s, s, s) & bounds, cv::Scalar(0, 200, 255), 1, cv::LINE_8);
-}
-
 } // namespace
 
-KeyOutcome applyKey(LiveControls& controls, int key, double focusM)
-{
-    KeyOutcome outcome;
-    outcome.handled = true;
-    LensSettings& lens = controls.lens;
-    bool lensChanged = false;
-    switch (key) {
-    case '1': case '2': case '3': case '4': case '5': case '6': case '7':
-        controls.view = kAllViews[key - '1'];
-        outcome.message = fmt::format("view {} {}", key - '0', viewName(controls.view));
-        break;
-    case '+': case '=':
-    case '-': case '_':
-        lens.fNumber = thirdStop(lens.fNumber, key == '+' || key == '=' ? 1 : -1);
-        lensChanged = true;
-        break;
-    case '[':
-        lens.maxCocPx -= lens.maxCocPx <= 4.0 ? 0.5 : 2.0;
-        lensChanged = true;
-        break;
-    case ']':
-        lens.maxCocPx += lens.maxCocPx < 4.0 ? 0.5 : 2.0;
-        lensChanged = true;
-        break;
-    case 'j': // wider focal range: less blur (seed 003's keys)
-    case 'l': // narrower: more blur
-        lens.model = CocModel::FocalRange;
-        controls.nearRatio = key == 'j' ? controls.nearRatio / 1.25 : controls.nearRatio * 1.25;
-        controls.farRatio = key == 'j' ? controls.farRatio * 1.25 : controls.farRatio / 1.25;
-        lensChanged = true;
-        break;
-    case 'm':
-        lens.model = lens.model == CocModel::ThinLens ? CocModel::FocalRange : CocModel::ThinLens;
-        lensChanged = true;
-        break;
-    case 'f':
-        controls.autofocus = !controls.autofocus;
-        outcome.message = controls.autofocus ? "autofocus on" : "autofocus off (click to focus)";
-        break;
-    case 'c':
-        controls.recentre = true;
-        outcome.message = "focus: centre window";
-        break;
-    case 't':
-        controls.tileMap = !controls.tileMap;
-        outcome.message = controls.tileMap ? "tile map on (outlined tiles are blurred)" : "tile map off";
-        break;
-    case ' ':
-        controls.paused = !controls.paused;
-        outcome.message = controls.paused ? "paused" : "playing";
-        break;
-    case 'q': case 27:
-        controls.quit = true;
-        outcome.message = "quit";
-        break;
-    default:
-        outcome.handled = false;
-        return outcome;
-    }
-    if (lensChanged) {
-        // Judge the new values on the lens they will be used with, and keep the clamped ones.
-        const LensSettings used = lensFor(controls, focusM, &outcome.issues);
-        lens.fNumber = used.fNumber;
-        lens.maxCocPx = used.maxCocPx;
-        if (used.model == CocModel::FocalRange && std::isfinite(used.focusM)) {
-            controls.nearRatio = used.nearLimitM / used.focusM;
-            controls.farRatio = used.farLimitM / used.focusM;
-        }
-        outcome.message = fmt::format("f/{}, max CoC {:.1f} px, {}", fNumberText(used.fNumber), used.maxCocPx,
-                                      rangeText(used));
-    }
-    ++controls.revision;
-    return outcome;
-}
-
-LensSettings lensFor(const LiveControls& controls, double focusM, std::vector<SettingIssue>* issues)
-{
-    LensSettings lens = controls.lens;
-    lens.focusM = focusM;
-    if (std::isfinite(focusM)) {
-        lens.nearLimitM = focusM * controls.nearRatio;
-        lens.farLimitM = focusM * controls.farRatio;
-    } else {
-        lens.farLimitM = std::numeric_limits<double>::infinity();
-    }
-    auto found = validate(lens, true);
-    if (issues)
-        issues->insert(issues->end(), found.begin(), found.end());
-    return lens;
-}
-
-cv::Mat composeHud(const cv::Mat& frame, const HudStatus& status, const SceneAnalysis* tileMap)
+cv::Mat composeHud(const cv::Mat& frame, const Hud& hud)
 {
     CV_Assert(frame.type() == CV_8UC3 && !frame.empty());
     const int width = std::max(frame.cols, kMinHudWidth);
     cv::Mat out(frame.rows + kHudHeight, width, CV_8UC3, cv::Scalar(28, 28, 28));
     cv::Mat picture = out(cv::Rect(0, 0, frame.cols, frame.rows));
     frame.copyTo(picture);
-    if (tileMap)
-        drawTileMap(picture, *tileMap);
-    drawFocusMarks(picture, status.focusWindow, status.autofocus);
+    const cv::Rect bounds(0, 0, picture.cols, picture.rows);
+    for (const cv::Rect& outline : hud.outlines)
+        cv::rectangle(picture, outline & bounds, cv::Scalar(0, 200, 255), 1, cv::LINE_8);
+    drawMarks(picture, hud.marks);
 
-    const LensSettings& lens = status.lens;
-    std::string focus = fmt::format("focus {:.2f} m [{}{}]", status.focusM, status.autofocus ? "auto" : "manual",
-                                    status.tapped ? ", tapped" : "");
-    if (std::abs(status.targetM - status.focusM) > 0.005 * status.focusM)
-        focus += fmt::format(" -> {:.2f} m", status.targetM);
-    std::string state = status.paused ? "  PAUSED" : status.ended ? "  end of clip (held)" : "";
-    std::string gpu;
-    for (const auto& pass : status.gpu)
-        gpu += fmt::format("  {} {:.1f}", shortPassName(pass.name), pass.ms);
-    const FrameTimings& t = status.timings;
-    const std::string lines[] = {
-        fmt::format("{}   f/{}  {:.0f} mm  max CoC {:.1f} px  {}", focus, fNumberText(lens.fNumber), lens.focalLengthMm,
-                    lens.maxCocPx, rangeText(lens)),
-        fmt::format("view {} {}   {:.1f} fps   latency {:.0f} ms   dropped {}   frame {}{}{}", viewNumber(status.view),
-                    viewName(status.view), status.fps, status.latencyMs, status.dropped, status.frameIndex,
-                    status.live ? " (live)" : "", state),
-        fmt::format("ms: total {:.1f}  prep {:.1f}  analysis {:.1f}  upload {:.1f}  render {:.1f}  readback {:.1f}",
-                    t.totalMs, t.depthPrepMs, t.analysisMs, t.uploadMs, t.renderMs, t.readbackMs),
-        "gpu ms/pass:" + (gpu.empty() ? std::string("  n/a") : gpu),
-        status.message.empty() ? std::string("keys: 1-7 view  +/- f-number  [ ] max CoC  j/l range  f autofocus  "
-                                             "t tiles  spc pause  s shot  q quit")
-                               : status.message,
-    };
     int y = frame.rows + kLineHeight;
-    for (const auto& line : lines) {
-        const bool last = &line == &lines[std::size(lines) - 1];
-        const cv::Scalar ink = last && status.warning ? cv::Scalar(60, 160, 255)
-                               : last                 ? cv::Scalar(190, 190, 190)
-                                                      : cv::Scalar(245, 245, 245);
+    const auto draw = [&](const std::string& line, const cv::Scalar& ink) {
         cv::putText(out, line, {8, y}, cv::FONT_HERSHEY_SIMPLEX, kFontScale, ink, 1, cv::LINE_AA);
         y += kLineHeight;
-    }
+    };
+    for (const auto& line : hud.lines)
+        draw(line, cv::Scalar(245, 245, 245));
+    draw(hud.note, hud.warning ? cv::Scalar(60, 160, 255) : cv::Scalar(190, 190, 190));
     return out;
 }
 
@@ -265,8 +98,7 @@ bool xServerAnswers()
 
 } // namespace
 
-DisplaySink::DisplaySink(LiveControls& controls, DisplayOptions options)
-    : controls_(controls), options_(std::move(options))
+DisplaySink::DisplaySink(DisplayOptions options) : options_(std::move(options))
 {
     // highgui's Qt backend aborts the whole process when it cannot reach a display, so look first.
     const auto set = [](const char* name) {
@@ -294,12 +126,6 @@ DisplaySink::~DisplaySink()
     finish();
 }
 
-void DisplaySink::setStatus(const HudStatus& status, const SceneAnalysis* tileMap)
-{
-    status_ = status;
-    tileMap_ = tileMap;
-}
-
 void DisplaySink::write(const cv::Mat& image)
 {
     if (!open_)
@@ -307,13 +133,8 @@ void DisplaySink::write(const cv::Mat& image)
     if (image.type() != CV_8UC3 || image.empty())
         throw SinkError(fmt::format("DisplaySink: expected a non-empty 8-bit BGR frame, got type {} {}x{}",
                                     image.type(), image.cols, image.rows));
-    HudStatus status = status_;
-    if (status.message.empty() && Clock::now() < messageUntil_) {
-        status.message = message_;
-        status.warning = messageWarning_;
-    }
     frameSize_ = image.size();
-    shown_ = composeHud(image, status, tileMap_);
+    shown_ = composeHud(image, hud_);
     cv::imshow(options_.title, shown_);
     ++written_;
     poll(1);
@@ -324,30 +145,23 @@ void DisplaySink::poll(int waitMs)
     if (!open_)
         return;
     const int key = cv::waitKey(std::max(1, waitMs));
-    if (key != -1)
-        handleKey(key);
+    if (key != -1) {
+        WindowEvent event;
+        event.key = key;
+        events_.push_back(event);
+    }
     if (cv::getWindowProperty(options_.title, cv::WND_PROP_VISIBLE) < 1.0) {
         open_ = false;
-        controls_.quit = true;
+        WindowEvent event;
+        event.kind = WindowEvent::Kind::Closed;
+        events_.push_back(event);
         logger().info("window closed");
     }
 }
 
-void DisplaySink::handleKey(int key)
+std::vector<WindowEvent> DisplaySink::takeEvents()
 {
-    if (key == 's') {
-        saveScreenshot();
-        return;
-    }
-    const KeyOutcome outcome = applyKey(controls_, key, focusForKeys_);
-    if (!outcome.handled) {
-        logger().debug("key {} does nothing; keys: {}", key, kKeyHelp);
-        return;
-    }
-    for (const auto& issue : outcome.issues)
-        note(fmt::format("clamped: {}", issue.message), true);
-    if (outcome.issues.empty() && !outcome.message.empty())
-        note(outcome.message, false);
+    return std::exchange(events_, {});
 }
 
 void DisplaySink::onMouse(int event, int x, int y, int, void* self)
@@ -355,48 +169,31 @@ void DisplaySink::onMouse(int event, int x, int y, int, void* self)
     auto& sink = *static_cast<DisplaySink*>(self);
     if (x < 0 || y < 0 || x >= sink.frameSize_.width || y >= sink.frameSize_.height)
         return; // the HUD band, or before the first frame
-    if (event == cv::EVENT_LBUTTONDOWN) {
-        sink.controls_.tap = cv::Point2d((x + 0.5) / sink.frameSize_.width, (y + 0.5) / sink.frameSize_.height);
-        ++sink.controls_.revision;
-        sink.note(fmt::format("tap to focus at ({}, {})", x, y), false);
-    } else if (event == cv::EVENT_RBUTTONDOWN) {
-        sink.controls_.recentre = true;
-        ++sink.controls_.revision;
-        sink.note("focus: centre window", false);
-    }
+    if (event != cv::EVENT_LBUTTONDOWN && event != cv::EVENT_RBUTTONDOWN)
+        return;
+    WindowEvent click;
+    click.kind = event == cv::EVENT_LBUTTONDOWN ? WindowEvent::Kind::LeftClick : WindowEvent::Kind::RightClick;
+    click.pixel = {x, y};
+    click.point = cv::Point2d((x + 0.5) / sink.frameSize_.width, (y + 0.5) / sink.frameSize_.height);
+    sink.events_.push_back(click);
 }
 
-void DisplaySink::note(std::string message, bool warning)
-{
-    if (warning)
-        logger().warn("{}", message);
-    else
-        logger().info("{}", message);
-    message_ = std::move(message);
-    messageWarning_ = warning;
-    messageUntil_ = Clock::now() + kMessageTime;
-}
-
-void DisplaySink::saveScreenshot()
+std::optional<Screenshot> DisplaySink::saveScreenshot()
 {
     if (shown_.empty())
-        return;
+        return std::nullopt;
     std::error_code ec;
     std::filesystem::create_directories(options_.screenshotDir, ec);
-    std::filesystem::path file;
+    Screenshot shot;
     do
-        file = options_.screenshotDir / fmt::format("defocus-preview-{:04}.png", ++screenshots_);
-    while (std::filesystem::exists(file, ec));
-    bool ok = false;
+        shot.file = options_.screenshotDir / fmt::format("defocus-preview-{:04}.png", ++screenshots_);
+    while (std::filesystem::exists(shot.file, ec));
     try {
-        ok = cv::imwrite(file.string(), shown_, {cv::IMWRITE_PNG_COMPRESSION, 9});
+        shot.written = cv::imwrite(shot.file.string(), shown_, {cv::IMWRITE_PNG_COMPRESSION, 9});
     } catch (const cv::Exception&) {
-        ok = false;
+        shot.written = false;
     }
-    if (ok)
-        note(fmt::format("screenshot: {}", file.string()), false);
-    else
-        note(fmt::format("screenshot: cannot write '{}'", file.string()), true);
+    return shot;
 }
 
 void DisplaySink::finish()

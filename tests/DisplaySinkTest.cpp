@@ -1,8 +1,7 @@
-// The display sink's logic without a window: what each key does to the live controls (with
-// clamping through validate()), and the picture the window would show (frame + HUD band).
-// The window itself is tested under Xvfb by scripts/display-test.sh (CTest label "display").
-#include <cmath>
-
+// The display sink's drawing without a window: the picture the window would show (the frame,
+// untouched but for the marks and outlines it is given, and the HUD band below it).
+// What the keys do is tested in PreviewControllerTest.cpp; the window itself under Xvfb by
+// scripts/display-test.sh (CTest label "display").
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -10,120 +9,6 @@
 
 namespace defocus {
 namespace {
-
-TEST(DisplayControls, NumberKeysChooseTheLabViewsThenDepthAndCoc)
-{
-    LiveControls controls;
-    for (int i = 0; i < 7; ++i) {
-        const auto outcome = applyKey(controls, '1' + i, 2.0);
-        EXPECT_TRUE(outcome.handled);
-        EXPECT_EQ(controls.view, kAllViews[i]);
-    }
-    EXPECT_EQ(controls.view, View::Coc);
-}
-
-TEST(DisplayControls, FNumberMovesByThirdStopsOnTheStandardScale)
-{
-    LiveControls controls; // f/2
-    applyKey(controls, '+', 2.0);
-    EXPECT_NEAR(controls.lens.fNumber, std::exp2(7.0 / 6.0), 1e-12); // 2.24
-    applyKey(controls, '+', 2.0);
-    applyKey(controls, '=', 2.0); // the unshifted '+' key
-    EXPECT_NEAR(controls.lens.fNumber, std::sqrt(8.0), 1e-12);     // f/2.8: one stop
-    applyKey(controls, '-', 2.0);
-    applyKey(controls, '-', 2.0);
-    applyKey(controls, '_', 2.0);
-    EXPECT_NEAR(controls.lens.fNumber, 2.0, 1e-12);
-}
-
-TEST(DisplayControls, ImpossibleFNumbersAreClampedWithAWarning)
-{
-    LiveControls controls;
-    controls.lens.fNumber = 64.0;
-    auto outcome = applyKey(controls, '+', 2.0);
-    EXPECT_DOUBLE_EQ(controls.lens.fNumber, 64.0);
-    ASSERT_EQ(outcome.issues.size(), 1u);
-    EXPECT_EQ(outcome.issues[0].parameter, "--f-number");
-    controls.lens.fNumber = 0.7;
-    outcome = applyKey(controls, '-', 2.0);
-    EXPECT_DOUBLE_EQ(controls.lens.fNumber, 0.7);
-    ASSERT_EQ(outcome.issues.size(), 1u);
-    // A step inside the range says nothing.
-    EXPECT_TRUE(applyKey(controls, '+', 2.0).issues.empty());
-}
-
-TEST(DisplayControls, BracketsChangeMaxCocAndClampAtZero)
-{
-    LiveControls controls; // 32 px
-    applyKey(controls, ']', 2.0);
-    EXPECT_DOUBLE_EQ(controls.lens.maxCocPx, 34.0);
-    controls.lens.maxCocPx = 1.0;
-    applyKey(controls, '[', 2.0);
-    applyKey(controls, '[', 2.0);
-    EXPECT_DOUBLE_EQ(controls.lens.maxCocPx, 0.0);
-    const auto outcome = applyKey(controls, '[', 2.0);
-    EXPECT_DOUBLE_EQ(controls.lens.maxCocPx, 0.0);
-    ASSERT_EQ(outcome.issues.size(), 1u);
-    EXPECT_EQ(outcome.issues[0].parameter, "--max-coc");
-}
-
-TEST(DisplayControls, JWidensAndLNarrowsTheFocalRangeWhichStaysAroundTheFocus)
-{
-    LiveControls controls;
-    EXPECT_EQ(controls.lens.model, CocModel::ThinLens);
-    applyKey(controls, 'j', 2.0);
-    EXPECT_EQ(controls.lens.model, CocModel::FocalRange);
-    const LensSettings wide = lensFor(controls, 2.0);
-    EXPECT_NEAR(wide.nearLimitM, 1.0 / 1.25, 1e-12);
-    EXPECT_NEAR(wide.farLimitM, 6.0 * 1.25, 1e-12);
-    for (int i = 0; i < 12; ++i)
-        applyKey(controls, 'l', 2.0);
-    // Narrowed past the focus: validate() clamps the limits just around it, with a warning.
-    const LensSettings narrow = lensFor(controls, 2.0);
-    EXPECT_LT(narrow.nearLimitM, 2.0);
-    EXPECT_GT(narrow.farLimitM, 2.0);
-    EXPECT_GT(narrow.nearLimitM, 1.9);
-    EXPECT_LT(narrow.farLimitM, 2.1);
-    EXPECT_FALSE(applyKey(controls, 'l', 2.0).issues.empty());
-    // The range follows the focus in proportion.
-    const LensSettings far = lensFor(controls, 4.0);
-    EXPECT_NEAR(far.nearLimitM / 4.0, narrow.nearLimitM / 2.0, 1e-9);
-    applyKey(controls, 'm', 2.0);
-    EXPECT_EQ(controls.lens.model, CocModel::ThinLens);
-}
-
-TEST(DisplayControls, TogglesQuitAndUnknownKeys)
-{
-    LiveControls controls;
-    const auto before = controls.revision;
-    EXPECT_FALSE(applyKey(controls, 'x', 2.0).handled);
-    EXPECT_EQ(controls.revision, before);
-    applyKey(controls, 'f', 2.0);
-    EXPECT_FALSE(controls.autofocus);
-    applyKey(controls, 't', 2.0);
-    EXPECT_TRUE(controls.tileMap);
-    applyKey(controls, ' ', 2.0);
-    EXPECT_TRUE(controls.paused);
-    applyKey(controls, 'c', 2.0);
-    EXPECT_TRUE(controls.recentre);
-    EXPECT_GT(controls.revision, before);
-    EXPECT_FALSE(controls.quit);
-    applyKey(controls, 27, 2.0);
-    EXPECT_TRUE(controls.quit);
-    controls.quit = false;
-    applyKey(controls, 'q', 2.0);
-    EXPECT_TRUE(controls.quit);
-}
-
-TEST(DisplayControls, FocusCloserThanTheFocalLengthIsClampedForTheFrame)
-{
-    LiveControls controls;
-    std::vector<SettingIssue> issues;
-    const LensSettings lens = lensFor(controls, 0.01, &issues); // 1 cm < 50 mm
-    EXPECT_GT(lens.focusM, 0.05);
-    ASSERT_EQ(issues.size(), 1u);
-    EXPECT_EQ(issues[0].parameter, "--focus");
-}
 
 cv::Mat gradient(cv::Size size)
 {
@@ -134,13 +19,25 @@ cv::Mat gradient(cv::Size size)
     return image;
 }
 
+Hud someLines()
+{
+    Hud hud;
+    hud.lines = {"focus 2.00 m [auto]   f/2.0  50 mm  max CoC 32.0 px  thin-lens",
+                 "view 5 composite   0.0 fps   latency 0 ms   dropped 0   frame 0",
+                 "ms: total 0.0  prep 0.0  analysis 0.0  upload 0.0  render 0.0  readback 0.0",
+                 "gpu ms/pass:  n/a"};
+    hud.note = "keys: 1-7 view  +/- f-number  [ ] max CoC  j/l range  f autofocus  t tiles  spc pause  s shot  q quit";
+    return hud;
+}
+
+// Defects: marks drawn elsewhere than the region they are given, the frame scaled or recoloured,
+// or a band without its text.
 TEST(DisplayHud, FrameIsShownAsItIsWithTheHudBandBelow)
 {
     const cv::Mat frame = gradient({640, 480});
-    HudStatus status;
-    const cv::Mat shown = composeHud(frame, status);
+    const cv::Mat shown = composeHud(frame, someLines());
     ASSERT_EQ(shown.size(), cv::Size(640, 480 + kHudHeight));
-    // Only the focus-window marks (the centre 10 %, 64 x 48 px, and 2 px around) touch the frame.
+    // Only the marks (the centre 10 %, 64 x 48 px, and 2 px around) touch the frame.
     cv::Mat diff;
     cv::absdiff(shown(cv::Rect(0, 0, 640, 480)), frame, diff);
     cv::Mat changed;
@@ -156,42 +53,47 @@ TEST(DisplayHud, FrameIsShownAsItIsWithTheHudBandBelow)
     EXPECT_LT(light, 0.4);
 }
 
-TEST(DisplayHud, BandFollowsTheStatus)
+// Defects: a band that ignores the lines or the note it is handed, or draws a warning like any note.
+TEST(DisplayHud, BandShowsTheLinesAndTheNoteItIsGiven)
 {
     const cv::Mat frame = gradient({320, 240});
-    HudStatus a;
-    HudStatus b = a;
-    b.view = View::Coc;
-    b.focusM = 3.25;
-    b.message = "clamped: --f-number must be between 0.7 and 64, not 71.8";
-    b.warning = true;
-    const cv::Mat shownA = composeHud(frame, a), shownB = composeHud(frame, b);
+    const Hud a = someLines();
+    Hud b = a;
+    b.lines[1] = "view 7 coc   0.0 fps   latency 0 ms   dropped 0   frame 0";
+    Hud warned = a;
+    warned.note = "clamped: --f-number must be between 0.7 and 64, not 71.8";
+    warned.warning = true;
+    const cv::Mat shownA = composeHud(frame, a), shownB = composeHud(frame, b), shownW = composeHud(frame, warned);
     // Narrow frames are padded so the HUD fits.
     ASSERT_EQ(shownA.size(), cv::Size(560, 240 + kHudHeight));
+    const cv::Rect band(0, 240, 560, kHudHeight);
     cv::Mat diff;
-    cv::absdiff(shownA(cv::Rect(0, 240, 560, kHudHeight)), shownB(cv::Rect(0, 240, 560, kHudHeight)), diff);
+    cv::absdiff(shownA(band), shownB(band), diff);
     EXPECT_GT(cv::countNonZero(diff.reshape(1)), 100);
+    // The warning is orange (BGR: red above blue); the other lines are grey to white.
+    cv::Mat channels[3];
+    cv::split(shownW(band), channels);
+    EXPECT_GT(cv::countNonZero(channels[2] > channels[0] + 100), 50);
+    cv::split(shownA(band), channels);
+    EXPECT_EQ(cv::countNonZero(channels[2] > channels[0] + 100), 0);
 }
 
-TEST(DisplayHud, TileMapOutlinesOnlyTheTilesThatNeedBlur)
+// Defects: outlines not drawn, drawn filled, or drawn past the frame into the band.
+TEST(DisplayHud, OutlinesAreDrawnWhereGivenAndClippedToTheFrame)
 {
     const cv::Mat frame(64, 64, CV_8UC3, cv::Scalar(40, 40, 40));
-    SceneAnalysis analysis;
-    analysis.tiles = {4, 4};
-    analysis.tileMinCoc = cv::Mat(4, 4, CV_32F, cv::Scalar(0.0f));
-    analysis.tileMaxCoc = cv::Mat(4, 4, CV_32F, cv::Scalar(0.0f));
-    analysis.tileMaxCoc.at<float>(0, 0) = 3.0f;  // tile (0, 0) is blurred
-    analysis.tileMinCoc.at<float>(3, 3) = -2.0f; // so is tile (3, 3), in front of the focus
-    HudStatus status;
-    status.focusWindow.centre = {0.5, 0.5};
-    const cv::Mat shown = composeHud(frame, status, &analysis);
+    Hud hud;
+    hud.marks.centre = {0.5, 0.5};
+    hud.outlines = {cv::Rect(0, 0, 16, 16), cv::Rect(48, 48, 32, 32)}; // the second reaches past the frame
+    const cv::Mat shown = composeHud(frame, hud);
     const auto at = [&](int x, int y) { return shown.at<cv::Vec3b>(y, x); };
     const cv::Vec3b grey(40, 40, 40);
-    EXPECT_NE(at(0, 8), grey);   // left edge of tile (0, 0)
-    EXPECT_NE(at(63, 56), grey); // right edge of tile (3, 3)
-    EXPECT_EQ(at(8, 8), grey);   // inside tile (0, 0)
-    EXPECT_EQ(at(48, 8), grey);  // edge of tile (3, 0): in focus
-    EXPECT_EQ(at(16, 56), grey); // edge of tile (1, 3): in focus
+    EXPECT_NE(at(0, 8), grey);   // left edge of the first
+    EXPECT_NE(at(63, 56), grey); // its right edge, clipped to the frame
+    EXPECT_NE(at(56, 63), grey); // its bottom edge, clipped to the frame
+    EXPECT_EQ(at(8, 8), grey);   // inside the first
+    EXPECT_EQ(at(56, 56), grey); // inside the second
+    EXPECT_EQ(at(32, 8), grey);  // outside both
 }
 
 } // namespace
