@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The README's second command (and CI's, with --all): installs the Debian packages the tier needs
 # when missing (scripts/setup.sh), builds, and runs a tier of the tests under CTest, chosen by label.
 #   scripts/test.sh [--all] [CTEST_OPTIONS...]      exit status is ctest's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The preview window: key and mouse controls, HUD composition and screenshots, on highgui.
 #include "sinks/DisplaySink.hpp"
 

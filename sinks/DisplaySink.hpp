@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A window on the screen (OpenCV highgui): each frame with a HUD band below it, and the live
 // controls its keys and mouse drive. The preview loop reads the controls every frame.
 //   defocus-preview data/tum_fr1_rpy                 (keys: kKeyHelp below, docs/preview.md)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The display sink's logic without a window: what each key does to the live controls (with
 // clamping through validate()), and the picture the window would show (frame + HUD band).
 // The window itself is tested under Xvfb by scripts/display-test.sh (CTest label "display").
