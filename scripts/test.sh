@@ -8,8 +8,8 @@
 #              long end-to-end runs below: the GoogleTest suites (labels unit = no GL, gl = renders
 #              on EGL, llvmpipe is enough; gst = the GStreamer element's harness tests), and the
 #              end-to-end tests labelled batch, corpus, display, and exit_status and
-#              library_symbols. About 3 minutes on 2 cores (2 min 52 s with a
-#              busy machine, load average 6-12).
+#              library_symbols, and gst_frame_count. About 2 minutes on 2 cores (README,
+#              "Testing", gives the measured run).
 #   --all      every tier; what .ci/run calls. It adds the tests with these labels:
 #                long        the hard-case sweep (HardCasesGLTest) and gst-launch-1.0 pipelines
 #                install     install into a prefix (programs, scripts, tests/consumer built against
