@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // PSNR, SSIM and the region split of the error (see Metrics.hpp for the definitions).
 #include "bench/Metrics.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Error of a result against a ground truth (both CV_32FC3 linear BGR): PSNR of linear values
 // clipped to [0, 1], PSNR after sRGB encoding, SSIM on luma, PSNR per region (in focus, out of
 // focus, depth edge) with the regions drawn from the thin-lens CoC map, and PSNR and share of the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Writes OUTPUT, a C++ file that maps each shader's file name to its source text.
 # Run as: cmake -DOUTPUT=file.cpp -DSHADERS="a.frag|b.glsl" -P EmbedShaders.cmake
 string(REPLACE "|" ";" SHADERS "${SHADERS}")

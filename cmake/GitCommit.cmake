@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Writes OUTPUT, a C++ file defining defocus::buildCommit(): the source tree's git commit
 # (abbreviated, "+dirty" when tracked files differ from it), or "unknown" outside a git checkout.
 # Run at every build as: cmake -DSOURCE_DIR=... -DOUTPUT=file.cpp -P GitCommit.cmake

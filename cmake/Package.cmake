@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # A Debian package of what `cmake --install` installs (the programs, libdefocus with its headers
 # and CMake/pkg-config files, the GStreamer plugin, the batch scripts), so that a cluster admin
 # installs one package on every node:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The public settings as the pipeline's: filter/ApiSettings.hpp.
 #include "filter/ApiSettings.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The public settings (include/defocus/Settings.hpp: Lens, Quality) as the pipeline's own
 // (filter/Settings.hpp: LensSettings, QualitySettings), for libdefocus and for the programs that
 // parse the public words but drive the pipeline directly (the preview, the bench). Internal: not

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Autofocus: centre-weighted focus measurement (after the seed report 003: a small centre view,
 // parabolic weights, separable) and a critically damped spring in dioptres.
 #include "filter/Autofocus.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Automatic focus distance from the depth map: a parabolically weighted centre window (or a
 // tapped point), smoothed over time by a critically damped spring in dioptres (1/m).
 //   defocus-preview data/tum_fr1_rpy              (autofocus on; click = tap to focus; f toggles)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // sRGB decode/encode, with a 256-entry table for 8-bit decode.
 #include "filter/ColorSpace.hpp"
 

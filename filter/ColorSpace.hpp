@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The sRGB transfer functions on the CPU (the GPU uses sRGB textures and framebuffers).
 #pragma once
 

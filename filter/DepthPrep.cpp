@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Nearest-neighbour resize and push-pull hole filling of depth maps (Gortler et al. 1996).
 #include "filter/DepthPrep.hpp"
 

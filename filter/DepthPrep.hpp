@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Depth as the CoC pass needs it: colour-sized, in metres, with every hole filled.
 #pragma once
 

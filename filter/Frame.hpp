@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // One RGB-D frame as it travels from a source to the filter: colour, depth in metres, and where
 // it came from (for messages). Sources fill it; the pipeline reads it.
 #pragma once

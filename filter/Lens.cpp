@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Thin-lens and focal-range CoC coefficients.
 #include "filter/Lens.hpp"
 

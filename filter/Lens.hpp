@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The lens model: signed circle-of-confusion diameter in pixels as a function of depth.
 // The CPU derives two multiply-add coefficients; the CoC shader only evaluates them.
 #pragma once

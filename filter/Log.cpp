@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The library's logger: one sink that hands each message to the handler, or writes it to
 // standard error when there is none (filter/Log.hpp).
 #include "filter/Log.hpp"

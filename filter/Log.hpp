@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The logger the library's code writes its messages through: `logger().warn("...", ...)`. Where
 // they go is set by setLogHandler (include/defocus/Log.hpp); never standard output. Internal.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Pipeline: owns the targets, runs the passes in order, reads results back, times everything.
 #include "filter/Pipeline.hpp"
 

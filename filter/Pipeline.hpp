@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The depth-of-field pipeline for one frame: a frame whose valid depths all give less than half a
 // pixel of CoC is passed through before anything else; otherwise depth hole filling, upload, the
 // scene analysis (CPU) and the per-frame plan (which tiles blur, which are copied, whether

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The quality presets users choose between, as the pipeline's settings, and why each is what it is.
 #include "filter/Presets.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The quality presets (fast, balanced, high: the public defocus::Quality::Preset) as the
 // pipeline's settings. They were chosen from the Pareto front of the accuracy benchmark
 // (docs/accuracy.md has the table and the command that measures it); the benchmark states each as

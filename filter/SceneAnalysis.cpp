@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Scene analysis: the measurement of a frame, the CoC ranges, the foreground's reach and the plan.
 #include "filter/SceneAnalysis.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What a frame calls for: per-tile CoC range, a CoC histogram, foreground blur, highlights and
 // holes, measured on the CPU from the frame and its filled depth before they are uploaded. The
 // plan made from it decides which passes run where.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The one place where settings are checked against their documented ranges.
 #include "filter/Settings.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The filter's settings, one struct per concern, each field with its unit, default and range.
 // All validation happens in validate() below: the CLI turns its messages into errors, an
 // interactive session clamps with a warning.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Legends and contact sheets, drawn with OpenCV.
 #include "filter/Views.hpp"
 

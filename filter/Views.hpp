@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // CPU-side finishing of views: the legend of the colour-mapped views and the labelled contact
 // sheet of all views of a frame.
 #pragma once

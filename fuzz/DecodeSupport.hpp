@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Shared by the decoder fuzz targets: OpenCV set up once, quietly, and the header check that
 // every decoded image must agree with.
 #pragma once

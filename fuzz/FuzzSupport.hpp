@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Shared by the fuzz targets: a check that survives NDEBUG and reports what broke.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Fuzzes decodeColor(): any bytes give 8-bit sRGB or float linear BGR of the size the header
 // states, or a SourceError that names the file; never a crash, a leak or an allocation past the
 // pixel limit. Colour decoded from 16-bit samples must lie in [0, 1].

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Fuzzes decodeDepth(): any bytes give CV_32FC1 metres of the size the header states, or a
 // SourceError that names the file; never a crash, a leak or an allocation past the pixel limit.
 #include <cstddef>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Fuzzes the TUM list parsers and the timestamp pairing from memory. The input is rgb.txt, a NUL
 // byte, then depth.txt; the whole input is also parsed as associations.txt. Any text either
 // parses or throws SourceError naming LIST:LINE; what parses obeys the documented invariants.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Fuzzes parameter validation with arbitrary doubles (NaN, infinities, denormals included) and
 // ints: validate() without clamping changes nothing and names each bad parameter; clamping gives
 // settings that validate cleanly; valid lens settings give finite CoC coefficients and a CoC

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The GStreamer element `defocus`: colour on the `color` pad, depth on the `depth` pad, the depth
 // of field of a lens out of `src`, one frame per colour frame with its timestamp and duration,
 // each paired with the depth current at its running time (a GstVideoAggregator that runs its own

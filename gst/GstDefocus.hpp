@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // GstDefocus: the `defocus` element (GstVideoAggregator), registered by the plugin libgstdefocus.
 #pragma once
 

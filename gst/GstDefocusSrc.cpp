@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The GStreamer element `defocussrc`: what `defocus INPUT --depth DEPTH` reads (TUM folders named
 // by timestamp, folder pairs, a colour camera with a Z16 depth camera, ...) as two src pads, `color`
 // (BGR) and `depth` (GRAY16_LE in depth-scale units per metre), one buffer on each per frame with

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // GstDefocusSrc: the `defocussrc` element, the command line's inputs (TUM folders, folder pairs,
 // Z16 depth cameras, ...) as two src pads, `color` and `depth`; registered by libgstdefocus.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // libdefocus' messages to a GStreamer debug category and element warnings (gst/LibraryLog.hpp).
 #include "gst/LibraryLog.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // libdefocus' messages inside GStreamer: to the debug category "defocuslib" (GST_DEBUG=defocuslib:5),
 // never to standard output (which may carry the video: `gst-launch-1.0 -q ... ! fdsink`), and its
 // warnings as warning messages of the element that made the call, which a user sees.

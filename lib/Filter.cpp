@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // libdefocus: the public API (include/defocus/) over the pipeline and its EGL context. The
 // settings are turned into the pipeline's exactly as the defocus command line turns its flags.
 #include "defocus/Filter.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The public logging hook (include/defocus/Log.hpp) over the library's logger (filter/Log.hpp).
 #include "defocus/Log.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // libdefocus: the public Source (include/defocus/Source.hpp) over the command line's sources.
 #include "defocus/Source.hpp"
 

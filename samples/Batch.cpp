@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Manifest parsing, shards, reports and partial-output removal for defocus --batch (Batch.hpp).
 #include "samples/Batch.hpp"
 #include "samples/BenchMachine.hpp"

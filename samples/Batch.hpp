@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Many clips in one process (defocus --batch MANIFEST): the manifest, the share of it one process
 // takes (--shard I/N, or a Slurm array task's index), each clip's report, written last and
 // atomically, and what a rerun does again: every clip whose report does not say done. The

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus-bench accuracy --scene DIR: the presets measured on a corpus of scene folders.
 #include "samples/BenchCorpus.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The accuracy benchmark over scene folders (`defocus-bench accuracy --scene DIR ...`): every
 // preset on every scene of a corpus, PSNR per scene and per zone (lights, depth edges, in focus,
 // near, far), the minimum and the median per preset, and the anchors (Blender's Defocus node,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Run and machine description, and the statistics, for defocus-bench and defocus-bench-accuracy.
 #include "samples/BenchMachine.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What the benchmark programs and the batch reports share: when and on which CPU a run was made,
 // and the statistics they report (median and p90 with linear interpolation between order
 // statistics).

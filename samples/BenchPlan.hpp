@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus-bench plan: the per-frame plan against every pass on every pixel ("measure
 // and record"), on the TUM clip at an open and a closed aperture and on the synthetic clips:
 // ms per frame of each, frames in and out, and how far apart their outputs are.

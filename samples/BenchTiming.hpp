@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus-bench timing: for each preset, the frame's wall time (process and readback, as users
 // wait for it) and each pass's GPU time, as ratios to a calibration pass measured in the same
 // run, written as a baseline or compared with one. Ratios hold on a noisy or different machine

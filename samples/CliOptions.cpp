@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Command-line plumbing shared by the defocus programs: parse errors, stderr logging, signals.
 #include "samples/CliOptions.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What every defocus program shares on its command line: parsing with one error line and exit
 // status 2, logging to standard error, and Ctrl-C/SIGTERM that finish the clip in hand.
 //   int main(int argc, char** argv) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The exit statuses every defocus program returns, one table for all of them (README, "Exit
 // status"). A batch runner reads them: 1 and 2 will fail again on the same input, 75 and the
 // signal statuses are worth a retry.

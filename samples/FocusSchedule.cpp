@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Focus over a clip: fixed, first-frame auto, tracking autofocus and keyframed pulls.
 #include "samples/FocusSchedule.hpp"
 

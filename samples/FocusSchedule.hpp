@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Focus over the frames of a recorded clip, as --focus and --focus-point ask for it:
 //   --focus 1.2                 fixed, metres ('inf' for infinity)
 //   --focus auto                the median depth of the centre (or of --focus-point) of the first frame

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Frame feed (newest-frame capture thread for live sources), pacing and statistics of the preview.
 #include "samples/LiveLoop.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Helpers of the preview loop: a frame feed that never blocks on live sources (a capture thread
 // keeps only the newest frame and counts the ones it replaces), playback pacing for recorded
 // clips, and latency/fps statistics.

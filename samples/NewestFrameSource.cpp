@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // NewestFrameSource: FrameFeed's newest-frame slot behind the FrameSource contract.
 #include "samples/NewestFrameSource.hpp"
 

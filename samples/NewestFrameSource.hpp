@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A live source read through FrameFeed (LiveLoop.hpp): a capture thread keeps only the newest
 // frame, so a consumer slower than the camera gets the newest frame and the camera never waits;
 // the frames it replaces are counted. The command line reads a camera this way when it writes to

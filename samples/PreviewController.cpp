@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The preview's controls: what each key and click does to the lens, the view and the focus,
 // and the HUD's text (samples/PreviewController.hpp).
 #include "samples/PreviewController.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What defocus-preview's keys and clicks do: the live controls they change (lens, view, focus
 // requests, pause, quit), the lens each frame is rendered with, and the HUD's text and marks,
 // handed to the window (sinks/DisplaySink.hpp) to draw. The preview loop reads the controls

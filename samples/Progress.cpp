@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Progress on stderr: a bar redrawn at most ten times a second on a terminal, a log line every
 // interval elsewhere.
 #include "samples/Progress.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Progress on standard error: on a terminal a one-line bar (frame i/N, frames per second, time
 // left) redrawn in place; elsewhere (a log file, Slurm, nohup, CI) a log line every few seconds
 // with the same figures, as ffmpeg and rsync do.

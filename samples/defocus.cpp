@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus: gives recorded RGB-D footage the depth of field of a real lens, with hexagonal bokeh.
 //   defocus data/tum_fr1_rpy -o out/tum.mp4 --focus 1.2 --f-number 1.4
 //   defocus photo.png --depth depth.png --depth-scale 1000 -o out.png --view coc

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus-bench: speed of the McIntosh pipeline, ms per pass and per frame, on the bundled TUM clip
 // resized to each frame size, for a defocused and an all-in-focus scene. A benchmark, not a test.
 //   defocus-bench                                    (run from the repository root)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus-bench-accuracy: what accuracy costs in time. Runs every method of the registry at every
 // knob setting on the Blender spheres scene (path-traced thin-lens truth), measures the error
 // (PSNR linear and sRGB, SSIM, PSNR per region) and the time (GPU per pass, wall per frame, median

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus-preview: a live depth-of-field preview with autofocus, keyboard and mouse controls.
 //   defocus-preview /dev/video0 --depth depth.png      (webcam + one depth image, fixed camera)
 //   defocus-preview /dev/video0 --depth /dev/video2    (colour + Z16 depth camera)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Soak: many frames through the pipeline, checking that memory and GL objects stay flat.
 //   defocus-soak --frames 10000 --width 160 --height 120 [--quality balanced]
 // Frames alternate between two sizes every 50 frames, so target reallocation is exercised too.

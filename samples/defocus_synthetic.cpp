@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus-synthetic: renders a synthetic scene's frame - the filter's input (pinhole colour, planar
 // depth) and the thin-lens reference - to files, and times the reference (docs/synthetic.md).
 //   defocus-synthetic --scene spheres --frame 0 -o out/synthetic

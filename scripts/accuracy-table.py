@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The method table of docs/accuracy.md ("The table") from a run of defocus-bench-accuracy on the
 # Blender scene: its accuracy.csv, the 32F rows (every 16F row is in the CSV), the presets in
 # bold, the unblurred input's dB given on the command line (the run prints it; the CSV has no row).

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # `defocus --batch` on one machine through GNU parallel: the manifest split into one shard per
 # process, one process per core (or JOBS), the same contract as a Slurm array (defocus.sbatch).
 #   scripts/batch-parallel.sh clips.tsv [defocus options]          JOBS=4 DEFOCUS=build/defocus ...

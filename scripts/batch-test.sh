@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # `defocus --batch` end to end on this machine, no scheduler but GNU parallel:
 #  1. scripts/batch-parallel.sh (two shards, two processes) over a manifest of five clips cut
 #     from the bundled TUM clip, one with an input that does not exist: exit 1, the four good

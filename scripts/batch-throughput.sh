@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Clips per minute through `defocus --batch` on this machine, three ways over the same manifest of
 # CLIPS small clips (FRAMES frames each of the bundled TUM clip, 640x480, --quality fast):
 #   per-core   one process per core, each a shard (scripts/batch-parallel.sh, GNU parallel)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Builds the Containerfile with podman and checks the image: defocus runs in it (--version, --info
 # on Mesa's llvmpipe, two frames of the bundled clip through --batch, a report written), and the
 # final stage holds no compiler (no gcc, g++, cc, c++) and no -dev package.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The README's first command on a fresh machine: installs the Debian packages that building and the
 # demo need when missing (scripts/setup.sh without options: no test-only packages), builds, renders
 # the bundled TUM clip with depth of field (a video + a contact sheet of every view), says where.

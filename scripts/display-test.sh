@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Runs the display probe (tests/display_probe.cpp) against a real window: starts Xvfb with its
 # framebuffer kept in a file (the probe's screenshots), and lets the probe drive defocus-preview
 # with xdotool. docs/preview.md.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Regenerates the figures README.md and docs/ quote, each from the command that measures it, into
 # docs/figures.json (machine-readable) and docs/figures.md (the same, to read), with the date, the
 # commit and the machine of the run. The documents quote docs/figures.md.

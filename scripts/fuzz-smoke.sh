@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Builds the libFuzzer targets (clang, ASan + UBSan) and runs each over its committed corpus in
 # fuzz/corpus/ for a few seconds: a crash, a leak, a sanitizer report or a failed invariant fails
 # the script. Long runs and what they found: docs/fuzzing.md.

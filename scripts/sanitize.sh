@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Builds the suite with AddressSanitizer and UndefinedBehaviorSanitizer and runs the tests that
 # exercise the CPU code (label unit: sources, sinks, lens, settings, depth preparation, analysis,
 # autofocus, metrics). Any report fails the run.

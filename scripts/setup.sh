@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Installs the Debian packages defocus needs, only those that are missing, then configures and
 # builds it. Safe to run again: a second run installs nothing and rebuilds only what changed.
 #   scripts/setup.sh [--tests | --all] [BUILD_DIR]   (default: build)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # A one-node Slurm cluster on this machine runs `defocus --batch` through scripts/defocus.sbatch:
 # munged, slurmctld and slurmd from Debian's packages, configured in a temporary folder (state,
 # spool, logs, munge key and socket all there, removed at the end; nothing under /etc or /var is

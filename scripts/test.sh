@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The README's second command (and CI's, with --all): installs the Debian packages the tier needs
 # when missing (scripts/setup.sh), builds, and runs a tier of the tests under CTest, chosen by label.
 #   scripts/test.sh [--all] [CTEST_OPTIONS...]      exit status is ctest's
@@ -7,8 +8,8 @@
 #              long end-to-end runs below: the GoogleTest suites (labels unit = no GL, gl = renders
 #              on EGL, llvmpipe is enough; gst = the GStreamer element's harness tests), and the
 #              end-to-end tests labelled batch, corpus, display, and exit_status and
-#              library_symbols. About 3 minutes on 2 cores (2 min 52 s with a
-#              busy machine, load average 6-12).
+#              library_symbols, and gst_frame_count. About 2 minutes on 2 cores (README,
+#              "Testing", gives the measured run).
 #   --all      every tier; what .ci/run calls. It adds the tests with these labels:
 #                long        the hard-case sweep (HardCasesGLTest) and gst-launch-1.0 pipelines
 #                install     install into a prefix (programs, scripts, tests/consumer built against

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Runs the V4L2 capture probe (tests/v4l2_vm_probe.cpp) against real kernel drivers in a small
 # qemu VM: Debian's own kernel with vivid (colour formats) and v4l2loopback (Z16, MJPEG), the
 # host root shared read-only over 9p. Facts behind each step: docs/v4l2.md.

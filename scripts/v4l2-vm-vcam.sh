@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The virtual camera, inside the VM of scripts/v4l2-vm-test.sh (v4l2loopback nodes /dev/video4,
 # /dev/video5, and /dev/video6 for v4l2sink alone): the command line writes INPUT (3 frames of the
 # bundled clip at half size, made by `v4l2-vcam-check prepare`: INPUT/rgb/%06d.png,

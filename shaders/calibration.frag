@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A fixed workload shaped like one blur pass (16 filtered taps along a line, a weighted sum):
 // timing regressions are reported as each pass's time over this one's, measured in the same
 // run, so a slower or busier machine does not read as a slower pipeline.

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // CoC pass (McIntosh et al. 2012, pass 1): linear colour in rgb, signed circle-of-confusion
 // diameter in pixels in alpha (near < 0 < far), from the frame's colour and filled depth
 // (coc_params.glsl).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The CoC of a depth, shared by the CoC pass (coc.frag) and the half-size upscale
 // (upscale.frag): the CPU derived the madd coefficients (filter/Lens.cpp); c = scale * x + offset
 // with x = 1/z for the thin lens, x = z for the focal-range model. Signed diameter in pixels of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Helpers shared by the fragment shaders (included, so no #version here).
 
 // The exact sRGB transfer functions (IEC 61966-2-1).

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The hexagon from the two results of the last blur pass.
 //   McIntosh et al. 2012 (default): the per-channel minimum of the two rhombus blurs is their
 //     intersection, a hexagon (flat edges parallel to the first pass). With NEAR_FIELD, the

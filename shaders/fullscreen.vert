@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // One triangle that covers the viewport; uv runs 0..1 over it. Shared by every pass.
 //
 //   (-1,3)

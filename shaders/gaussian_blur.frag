@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The 5x5 Gaussian of the "Toy Story - Depth of Field" WebGL demo: spread = aperture x distance
 // from the plane in focus, i.e. proportional to the centre's |CoC|. No bleeding rule.
 //

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // One directional blur of McIntosh, Riecke & DiPaola 2012, "Efficiently Simulating the Bokeh of
 // Polygonal Apertures in a Post-Process Depth of Field Shader". Run at 0 deg on the CoC pass,
 // then at +120 and -120 deg on that result; min() of the two is a hexagon:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The bokeh sprite's hexagon, shared by highlight_sprites.comp and highlight_sprite.vert/.frag.
 
 layout(std140, binding = 1) uniform SpriteParams {

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Bokeh sprites, step 2: the hexagon's coverage of this pixel times the sprite's light, added to
 // the output (blending GL_ONE, GL_ONE), where the gather would have brought the same light: to
 // a pixel with a blur of its own (|CoC| >= 1 px), unless it lies in front of the sprite and is

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Bokeh sprites, step 2: six triangles per sprite (highlight_sprites.comp), a hexagon just large
 // enough for the sprite's, of circumscribed diameter |CoC|, and the half pixel of its antialiased
 // edge (a quad around it shaded 38 % more pixels at 15 px).

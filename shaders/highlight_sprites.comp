@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Bokeh sprites, step 1 of 2 (highlights only where there are highlights): every
 // blurred pixel whose light the CoC pass gives to a sprite (highlights.glsl) appends one: its
 // position, CoC and that light, to a buffer that is also the instanced draw's indirect command,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Highlights, shared by the CoC pass (coc.frag) and the bokeh sprites (highlight_sprites.comp);
 // needs coc_params.glsl and common.glsl.
 

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Lights in focus put back, on frames with bokeh sprites (InFocusLightPass). The CoC pass lets a
 // light in focus (|CoC| < 1 px, above the highlight threshold) into the blur as what lies round
 // it, its stand-in (coc.frag, SPRITES; standIn() in highlights.glsl), so that its HDR value does

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The "lazy" 8-point gather of the GameStudio wiki's depth-of-field article (after Scheuermann
 // 2004): eight fixed points on the unit circle and square, scaled by the centre's CoC radius,
 // averaged; a tap whose blurriness differs from the centre's by more than a threshold is

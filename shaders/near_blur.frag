@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Near field (foreground) layer: the McIntosh gather leaves the silhouette of a blurred
 // foreground object sharp, where a real lens spreads it over whatever is behind. This pass
 // blurs a premultiplied layer of the foreground (pixels with CoC <= -0.5 px, coverage 1) with

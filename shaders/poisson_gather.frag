@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Riguer, Tatarchuk & Isidoro 2004, "Real-Time Depth of Field Simulation" (ShaderX2): a 12-tap
 // Poisson disc around the centre, scaled by the centre's CoC radius, with their bleeding rule.
 //

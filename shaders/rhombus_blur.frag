@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Energy-conserving hexagon from three one-sided rhombi. A regular hexagon of circumradius R is
 // the union of three rhombi that share its centre, each spanned by two of the three unit vectors
 // u1, u2, u3 (120 deg apart, towards alternate corners), and each rhombus is the convolution of

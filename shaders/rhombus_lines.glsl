@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The rhombus blur's lines (rhombus_blur.frag): how a tap is fetched, and the share of a pixel
 // that a nearer, blurrier tap covers. Shared with in_focus_light.frag, which weighs what it puts
 // back by the same coverage. Included, so no #version here.

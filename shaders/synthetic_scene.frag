@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Synthetic scenes (sources/SyntheticScene.cpp): procedural surfaces, lit by a sun and a sky,
 // or emitting HDR light. With SYNTHETIC_DEPTH defined it writes the planar depth instead.
 layout(location = 0) in vec3 vNormal;

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Synthetic scenes (sources/SyntheticScene.cpp): world-space vertices seen by one eye of the lens.
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Instanced 16x16 tiles instead of one full-screen triangle: each instance is one tile of the
 // target, drawn as a 4-vertex strip; uv matches fullscreen.vert's, so fragment shaders are shared.
 layout(location = 0) in ivec2 aTile; // per instance: tile column, row

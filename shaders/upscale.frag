@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Upscale (Resolution::Half): the frame-sized result from the half-size (or quarter-size:
 // BLUR_SCALE 0.25, DETAIL_BELOW_PX 4) blur R of C (the CoC pass's target), by way of
 // upscale_prefilter.frag's S (R sharpened) and D = R - C. With bil() the bilinear interpolation

@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Upscale prefilter (Resolution::Half), at half size: sharpens the blurred result so that the
 // bilinear upscale after it keeps its detail. Each frame-sized pixel centre lies a quarter of a
 // half-size texel from the nearest texel centre, so the upscale weighs texels 3/4 and 1/4 along

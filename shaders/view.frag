@@ -1,4 +1,5 @@
 #version 450 core
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Turns an intermediate target into something to look at: its colour as is, the filled depth
 // on a log scale, or the signed CoC on a diverging scale (near blue, in focus white, far red).
 #include "common.glsl"

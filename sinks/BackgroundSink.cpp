@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // BackgroundSink: one writing thread, a bounded queue of frames, the first error kept for the
 // caller.
 #include "sinks/BackgroundSink.hpp"

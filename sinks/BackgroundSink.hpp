@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A sink written on a thread of its own: while the filter works on the next frame, the last ones
 // are encoded and written (PNG encoding is single-threaded; at 1920x1080 a frame takes 50 ms).
 // Frames are written in the order given, all of them before finish() finalises the output.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The preview window on highgui: the frame with its HUD band, the keys and clicks it receives,
 // screenshots.
 #include "sinks/DisplaySink.hpp"

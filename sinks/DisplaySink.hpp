@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A window on the screen (OpenCV highgui): each frame with a HUD band below it, drawn from what
 // the program hands it (lines of text, focus marks, tile outlines), and the keys, clicks and the
 // closing of the window it receives, queued for the program. What a key does is the program's

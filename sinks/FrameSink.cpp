@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // openSink: picks the sink from the output path (folder/, video container, image file or
 // /dev/video* virtual camera).
 #include "sinks/FrameSink.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The one contract every output implements: frames in display order, then finish().
 //   -o out/        image sequence in the TUM layout: the input's frame names, rgb.txt, depth/
 //                  depth.txt and associations.txt (PNG, or EXR when the output is linear HDR)

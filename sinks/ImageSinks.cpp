@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Image sinks: numbered PNG/EXR sequences and single image files, written under a hidden
 // temporary name and renamed into place when the run is done.
 #include "sinks/ImageSinks.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Image outputs: a sequence in a folder laid out as a TUM RGB-D clip (PNG, or EXR when linear), or
 // one image file that each frame replaces.   defocus in/ -o out/   defocus photo.png --depth d.png -o out.exr
 // Both are written under a hidden temporary name beside the output (.out.partial/, .out.partial.png;

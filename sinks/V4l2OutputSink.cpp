@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The virtual camera: QUERYCAP (video output with write()), S_FMT YUYV + S_PARM on the first
 // frame, then one non-blocking write() per frame of BT.601 YUYV.
 #include "sinks/V4l2OutputSink.hpp"

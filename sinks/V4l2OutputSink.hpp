@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A virtual camera: frames written to a V4L2 output device (v4l2loopback), as YUYV 4:2:2 in
 // BT.601 limited range, so that any program that reads a webcam sees the filtered stream.
 //   sudo modprobe v4l2loopback video_nr=10 card_label=defocus exclusive_caps=1

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Video sink: chooses a FourCC per container with fallbacks, writes to a hidden temporary file and
 // renames it into place when finished.
 #include "sinks/VideoSink.hpp"

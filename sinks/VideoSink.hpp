@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Video output through cv::VideoWriter (FFmpeg): .mp4 as H.264 (avc1, plays in browsers), .mkv
 // as lossless FFV1, .webm as VP9, .avi as Motion JPEG; --codec h264|mp4v|ffv1|vp9|mjpg picks
 // another.   defocus data/tum_fr1_rpy -o out.mp4      defocus in/ -o out.mkv (lossless)

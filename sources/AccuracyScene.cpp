@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // scene.json of an accuracy scene folder: parsing with one clear error per bad field, and the
 // scene's images read as the benchmark measures them (linear colour and truth, depth in metres).
 #include "sources/AccuracyScene.hpp"

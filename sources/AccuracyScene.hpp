@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A scene folder for the accuracy benchmark: pinhole colour, planar depth, a thin-lens truth and
 // scene.json describing the lens that made the truth. `defocus-bench accuracy --scene DIR` reads
 // one folder, or every scene folder inside a corpus folder (data/corpus, docs/accuracy.md).

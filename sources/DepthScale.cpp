@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The depth-scale plausibility check: median valid depth against what sensors measure.
 #include "sources/DepthScale.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Depth that cannot silently be at the wrong scale: the median valid depth of a frame is held
 // against the distances a scene from a depth sensor can have, and a frame outside them gets one
 // warning with the likely fix.   defocus realsense_in_tum_layout/ -o out.mp4

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Folder pair source: lists the images of a colour folder (and a depth folder), sorts both by
 // name and reads them pair by pair.
 #include "sources/FolderPairSource.hpp"

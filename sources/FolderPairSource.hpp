@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A folder of colour images, optionally paired with a folder of depth images by sorted file name.
 //   defocus rgb_dir/ --depth depth_dir/ -o out/
 #pragma once

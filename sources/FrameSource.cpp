@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // openSource: recognises what the input path names (TUM folder, image folder, image or video
 // file) and opens the matching source.
 #include "sources/FrameSource.hpp"

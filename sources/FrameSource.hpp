@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The one contract every input implements: a pull-based stream of RGB-D frames.
 //   defocus data/tum_fr1_rpy -o out.mp4            (TUM layout: rgb.txt + depth.txt)
 //   defocus rgb_dir/ --depth depth_dir/ -o out/    (pair of folders, matched by sorted name)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Image header reader: signatures, sizes and cheap completeness checks for PNG, JPEG, TIFF, BMP,
 // WebP and OpenEXR, with every read bounds-checked.
 #include "sources/ImageHeader.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Reads an image's format and size from its header, without decoding a pixel, so that a file that
 // claims absurd dimensions or was cut short is rejected before OpenCV allocates or decodes.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Decodes colour and depth images from disk into the frame formats the filter expects
 // (colour: 8-bit sRGB or float linear BGR; depth: float metres).
 #include "sources/ImageIO.hpp"

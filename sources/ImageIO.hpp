@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Decoding of colour and depth images from disk into the forms the filter expects.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Depth providers (fixed image, sequence on disk, live Z16 node) and the source that attaches
 // their depth to each colour frame.
 #include "sources/PairedSource.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Colour from one source, depth from another: a fixed depth image, a depth sequence (folder or
 // TUM depth.txt) paired by index or by timestamp, or a live Z16 node paired by timestamp.
 //   defocus clip.mp4 --depth depth_dir/ -o out.mp4          (depth image k for video frame k)

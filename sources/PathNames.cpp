@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // File names: extensions in lower case, video clips by extension, natural order.
 #include "sources/PathNames.hpp"
 

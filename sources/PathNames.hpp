@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What a file's name says: its extension in lower case, whether it names a video clip, and the
 // natural order in which numbered frames sort by number ("frame2" before "frame10").
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // ReadAheadSource: one reading thread, a bounded queue of frames, the error after them.
 #include "sources/ReadAheadSource.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A recorded source read ahead on a thread of its own: while the filter works on one frame, the
 // next ones are decoded (PNG decoding is single-threaded; at 1920x1080 a colour and a depth
 // frame take 70 ms). Frames and the source's error come out in the order the source gives them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Single image source: reads one colour file and its depth file up front, then yields one frame.
 #include "sources/SingleImageSource.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // One colour image file, with an optional depth image file: a clip of one frame.
 //   defocus photo.png --depth depth.png -o out.png
 #pragma once

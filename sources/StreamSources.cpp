@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Opens cameras and pairs colour with depth from another source, by what the paths name.
 #include "sources/StreamSources.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Source selection for streams, called by openSource() before the file sources:
 //   defocus /dev/video0 [--depth depth.png | depth_dir/ | depth.txt | /dev/video2]
 //   defocus clip.mp4 --depth depth_dir/ | depth.txt            (depth image k for video frame k)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Synthetic scenes rasterised with GL: the pinhole colour and planar depth the filter takes, and a
 // thin-lens reference accumulated over renders from points of a polygonal aperture through
 // sheared frusta that keep the focus plane fixed (P. Haeberli and K. Akeley, "The Accumulation

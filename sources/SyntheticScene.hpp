@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Ground truth the project renders itself: procedural 3D scenes rasterised with GL, giving the
 // filter's input (pinhole colour + planar depth) and a thin-lens reference for the same frame,
 // accumulated from many renders through points of a polygonal aperture (Haeberli and Akeley 1990).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The named synthetic scenes: geometry, materials, and the shot (camera move and focus pull).
 #include <cmath>
 #include <stdexcept>

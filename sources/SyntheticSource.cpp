@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Synthetic source: frames rendered on demand by SyntheticScene.
 #include "sources/SyntheticSource.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A FrameSource that renders a synthetic scene frame by frame: the filter's input with no data
 // on disk, and, through scene(), the thin-lens reference of the same frame.
 //   defocus --demo -o out.mp4                       (60 frames of "spheres", focus pull)

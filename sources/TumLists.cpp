@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // TUM list files: line splitting, timestamp parsing, nearest-timestamp pairing and the frame rate
 // estimate, kept free of file access so that they can be fuzzed from memory.
 #include "sources/TumLists.hpp"

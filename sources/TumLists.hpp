@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Parsers for the TUM RGB-D list files (rgb.txt, depth.txt, associations.txt) and the pairing of
 // colour with depth by timestamp: pure functions on text, used by TumSource and the fuzzers.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // TUM RGB-D layout: parses rgb.txt / depth.txt / associations.txt, pairs colour with depth by
 // timestamp when no associations are given, and reads the pairs in list order.
 #include "sources/TumSource.hpp"

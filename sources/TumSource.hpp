@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Reads the TUM RGB-D benchmark layout: a folder with rgb.txt and depth.txt (paired by nearest
 // timestamp) or associations.txt (pairs given).   defocus data/tum_fr1_rpy -o out.mp4
 #pragma once

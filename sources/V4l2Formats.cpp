@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // V4L2 pixel format conversions: OpenCV's colour conversions on a Mat header laid over the
 // capture buffer, so each frame is read once and written once.
 #include "sources/V4l2Formats.hpp"

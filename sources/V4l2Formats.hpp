@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Conversions of V4L2 pixel formats into what a Frame holds: colour formats to BGR CV_8UC3,
 // Z16 depth to metres. Pure functions on bytes, so tests check them without a camera.
 #pragma once

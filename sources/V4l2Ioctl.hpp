@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Small helpers for talking to a V4L2 device node, shared by the camera source and the
 // virtual-camera sink.
 #pragma once

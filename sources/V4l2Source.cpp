@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // V4L2 capture: negotiation (QUERYCAP, ENUM_FMT, S_FMT, S_PARM), mmap streaming with poll(),
 // and the conversion of each buffer into a Frame before the buffer goes back to the driver.
 #include "sources/V4l2Source.hpp"

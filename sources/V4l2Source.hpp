@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A V4L2 camera read with the raw V4L2 API: mmap streaming, the driver's timestamps, colour
 // (YUYV, NV12, RGB3, BGR3, GREY, MJPG) or Z16 depth.
 //   defocus /dev/video0 --depth depth.png -o out.mp4 --frames 300

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Video file source: decodes frames with cv::VideoCapture and attaches the optional shared depth.
 #include "sources/VideoFileSource.hpp"
 

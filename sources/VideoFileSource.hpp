@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A video file decoded by cv::VideoCapture: colour only, with an optional single depth image
 // applied to every frame.   defocus clip.mp4 --depth depth.png -o out.mp4
 #pragma once

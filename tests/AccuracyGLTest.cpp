@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Accuracy smoke against a path-traced thin lens: the Blender spheres scene (data/
 // blender_spheres), PSNR of linear values clipped to [0, 1] against the Cycles truth.
 #include <cmath>

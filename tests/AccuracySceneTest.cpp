@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // scene.json of the accuracy corpus: the bundled scene read with its lens, and one clear error
 // naming the file and the field for each kind of bad scene.json.
 #include <filesystem>

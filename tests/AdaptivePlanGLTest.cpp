@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The per-frame plan (QualitySettings::adaptive: all-in-focus frames passed through, in-focus
 // tiles copied, tap loops cut to the frame's lines, upscale detail only where needed) is claimed
 // to cost nothing in the picture: the same clips rendered with the plan and with every pass on

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Autofocus without GL: the weighted window measurement, the spring's step response on noisy
 // synthetic depth, tap to focus, invalid windows, and convergence on the bundled TUM clip.
 #include <algorithm>

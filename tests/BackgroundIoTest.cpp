@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Reading ahead and writing behind on threads of their own (ReadAheadSource, BackgroundSink):
 // every frame once, in order, the errors where the caller expects them, and bounded queues.
 #include <atomic>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Bad input and a failure in the middle of a clip, through the defocus binary: the message names
 // the frame's file, the exit status is 1, nothing is written under the output's name (an earlier
 // output there stays) and no temporary file is left; with --keep-partial the frames before it are

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Bad input from disk: every broken file, list or folder gives one message that
 // names the file (and line or frame), through the library and through the defocus binary, and
 // leaves no output behind. The cases that need frames rendered before the failure are in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus --batch without GL: the manifest (TSV and JSON lines, per-clip options, what it
 // refuses), the shard a process takes (--shard, Slurm array variables), report paths, the atomic
 // report and what a rerun does again.

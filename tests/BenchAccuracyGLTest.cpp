@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus-bench accuracy on a scene folder, end to end: the bundled spheres scene read through
 // its scene.json must reproduce the presets' recorded figures, and the zone report must account
 // for every pixel and all of the error.

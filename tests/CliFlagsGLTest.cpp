@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Every option that `defocus --help` lists, through the binary: each test runs the program on a
 // tiny frame (161x121, the bundled TUM texture over depth planes made for the test) and checks
 // that the option changes the picture or the report the way its help line says, and the rules by

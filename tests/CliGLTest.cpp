@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The defocus program end to end: Ctrl-C (SIGINT) and SIGTERM leave nothing under the output's
 // name (--keep-partial keeps the frames so far beside it), every input frame gives an output frame, frames and focus chosen over time, and the depth-scale warning.
 #include <chrono>

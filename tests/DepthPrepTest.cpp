@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Depth preparation without GL: nearest resize, push-pull hole filling, centre depth.
 #include <algorithm>
 #include <cmath>

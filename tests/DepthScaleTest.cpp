@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The depth-scale plausibility check (sources/DepthScale): millimetre depth read at TUM's 5000
 // units per metre, and the reverse, give one warning with the fix; a room at the right scale none.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The display sink's drawing without a window: the picture the window would show (the frame,
 // untouched but for the marks and outlines it is given, and the HUD band below it).
 // What the keys do is tested in PreviewControllerTest.cpp; the window itself under Xvfb by

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Several EGL contexts in one process: each lives and ends on its own.
 #include <optional>
 

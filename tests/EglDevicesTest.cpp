@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Which EGL device a context is made on, without a GPU: the order deviceOrder() gives for
 // devices described as NVIDIA's EGL describes them (a CUDA id each), and Mesa's (none).
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Focus over a clip (samples/FocusSchedule): keyed pulls eased in dioptres, the depth under a
 // point, tracking focus and the errors for bad --focus values, frame by frame.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Fixture for tests that render: one headless EGL context per test program. Tests skip only
 // when no EGL platform at all gives a context; llvmpipe is enough for every GL test.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Resolution::Half: the blurs at half size, the output at the frame's size with its in-focus
 // pixels kept (coc.frag HALF_SIZE, upscale_prefilter.frag, upscale.frag).
 #include <array>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The hard-case suite: broken depth, extreme lens and quality settings, degenerate image sizes
 // and hostile colour, each run through both kernels (the rhombi and McIntosh's chain, with the
 // pipeline's plain settings) and the shipped presets (high at full size; balanced and fast, at

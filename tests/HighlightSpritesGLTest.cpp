@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Bokeh sprites (HighlightSpritePass, highlight_sprites.comp, highlight_sprite.vert/.frag): the
 // light of blurred pixels above white scattered as hexagons with exact edges, only on frames with
 // such lights.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // readColor / readDepth: bit depths, channel layouts, depth scales and the errors for bad files.
 #include <algorithm>
 #include <cmath>

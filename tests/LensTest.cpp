@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Lens maths without GL: thin-lens CoC values, signs, the madd derivation, the focal-range model.
 #include <cmath>
 #include <limits>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // libdefocus' public API (include/defocus/): its errors speak the command line's words, the
 // command line's automatic focus, the live autofocus, a Filter that follows the calling thread, and
 // what the defocus program takes from it: the contact sheet, the last frame's GPU times, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The preview's frame feed without a camera: a fake live source faster than its consumer drops
 // the oldest frames (counted) and never blocks; a recorded one delivers every frame; pacing and
 // the latency figures.

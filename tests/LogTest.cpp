@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // libdefocus' messages (include/defocus/Log.hpp): never on standard output, which belongs to the
 // program (`gst-launch-1.0 -q ... ! fdsink` writes video there); by default one line each on
 // standard error; to a handler when one is set, from the level it asks for.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The methods of the registry checked analytically on llvmpipe: zero CoC returns the input, flat
 // colour stays flat under any blur, bad input gives no NaN/Inf; the CPU reference turns a point
 // light into a hexagon of the predicted area and orientation, conserves energy, and beats every

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The accuracy metrics checked analytically: PSNR of identical images and of a known MSE, SSIM of
 // identical images, the region masks partitioning the image, and the zones of the corpus report.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The passes checked analytically on llvmpipe, on both kernels and (where a test is not about one
 // pass) every preset: zero CoC is the identity, a point light becomes a hexagon of the predicted
 // size and orientation, constant depth blurs uniformly, HDR light keeps its energy, near and far

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // File names (sources/PathNames): extensions in any case, video files by extension, and the
 // natural order by which colour and depth folders are paired frame by frame.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // End to end on the recorded TUM clip with each preset: every pair found, frames out = frames in,
 // every target finite, in-focus pixels unchanged, strongly blurred pixels changed.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What defocus-preview's keys and clicks do, without a window: each key's effect on the live
 // controls (with clamping through validate()), clicks and a closed window, and the HUD made from
 // the status (drawn by sinks/DisplaySink, DisplaySinkTest.cpp).

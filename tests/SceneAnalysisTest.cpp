@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The scene analysis (filter/SceneAnalysis): the tiles with highlights and the neighbourhoods the
 // bokeh sprites judge lights in, and the plan's tap loops.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Parameter validation: one place, messages naming parameter, value and range; clamping.
 #include <cmath>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Frame sinks: sequences in the TUM layout, videos of each codec read back with cv::VideoCapture,
 // single images, existing outputs refused without overwrite, and the errors for bad outputs.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Frame sources: TUM pairing (associations and timestamps), folder pairs, single images, video
 // files, and the errors for bad inputs.
 #include <cstdint>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Streams without a camera: V4L2 pixel format conversions against hand-computed values, a video
 // clip the test writes itself, depth from another source paired by index and by timestamp, and
 // the errors of camera paths that are no cameras. Capture from real drivers: tests/v4l2_vm_probe.cpp.

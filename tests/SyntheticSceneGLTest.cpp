@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The synthetic ground truth checked against the lens model it claims to follow: a point light's
 // bokeh has the filter's thin-lens CoC and the documented orientation, a tiny aperture gives the
 // pinhole image, light is conserved, depth is planar; and the Cycles truth agrees on both.

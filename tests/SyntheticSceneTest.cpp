@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The synthetic scenes' sampling and settings, without GL: lens positions fill the aperture
 // polygon uniformly by area with the documented orientation, pixel offsets fill the pixel.
 #include <cmath>

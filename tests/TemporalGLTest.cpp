@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Temporal stability: a static clip renders bit-identical frames (every preset, both kernels),
 // and +-1 % multiplicative noise on the depth map does not make in-focus pixels flicker (the
 // rhombus kernel at full size, and the half-size presets). The bounds are recorded in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Helpers shared by the tests: where the bundled data lives, scratch folders, image statistics.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The virtual camera's pixel conversion (BGR to BT.601 YUYV) against the textbook equations and
 // through the capture side's decoder, and its errors for outputs that are not virtual cameras.
 // Writing to a real v4l2loopback node is tested in the VM (scripts/v4l2-vm-test.sh, docs/v4l2.md).

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The CoC that scripts/corpus/anchors.py gives the tools it measures (GEGL's lens-blur takes it as
 # its blur radius per pixel) must be the CoC of the truth's camera, as the filter computes it.
 # Defect caught: the anchors blurred with the image-distance factor f / (S1 - f) where the renders'

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The window only shows frames: sinks/DisplaySink.hpp and .cpp may include of filter/ only the
 # frame and the logger, and nothing of samples/ (what a key does to the lens, the focus or the
 # view is samples/PreviewController's). Defect: the sink deciding keys, lens or focus again,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The display sink in a real window: runs defocus-preview on the bundled TUM clip under Xvfb,
 // reads the screen from Xvfb's framebuffer file (-fbdir, XWD format), and drives the window with
 // xdotool: the processed frame and the HUD are on screen, keys switch views (checked through

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Every defocus program's exit status for each kind of ending (samples/ExitStatus.hpp, README
 # "Exit status"): 0 done, 1 bad input or output, 2 command line, 75 no GL (retry), 130 Ctrl-C,
 # 143 SIGTERM; errors on standard error, one line, standard output left to results.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Installs defocus into a temporary prefix, builds tests/consumer against it twice (CMake package,
 # then pkg-config) and checks that each consumer's PNG of one bundled frame is the same file, byte
 # for byte, as the command line's with the same settings; that the GStreamer plugin is installed

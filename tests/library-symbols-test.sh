@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # libdefocus holds the product, not the benchmarks: no function or object that the benchmarks'
 # library (bench/, defocus_bench_lib) defines is in libdefocus.so, and none of the method zoo's
 # names is either (the registry, the metrics, the other methods' passes, the timing calibration),

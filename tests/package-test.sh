@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The Debian package (cpack -G DEB, cmake/Package.cmake) holds what a cluster admin needs on a
 # node: defocus and the other programs, libdefocus, the GStreamer plugin, the Slurm and GNU
 # parallel scripts; declares the Debian packages of the libraries it links (dpkg-shlibdeps); and

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Builds defocus as the subproject of tests/subproject (add_subdirectory, as FetchContent does):
 # the parent's build type is left alone, no test of defocus is defined, and the parent's program
 # linked to defocus::defocus gives the CLI's PNG, byte for byte.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A webcam reader for the virtual-camera test in the VM (scripts/v4l2-vm-test.sh): captures YUYV
 // frames from a v4l2loopback node while a writer (defocus -o /dev/videoN, or gst-launch-1.0 with
 // v4l2sink) fills it, then checks each captured frame against the filter's output written as PNGs

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // V4l2Source against real kernel drivers, run inside the VM of scripts/v4l2-vm-test.sh: vivid
 // for the colour formats, v4l2loopback (fed by a producer thread in this process) for Z16 depth
 // and MJPEG, two nodes paired by timestamp, and a camera unplugged mid-stream (vivid's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The gather methods' shared chain (upload, CoC pass, one pass, readback, GPU timers) and their
 // one-pass bodies.
 #include "bench/methods/GatherMethods.hpp"

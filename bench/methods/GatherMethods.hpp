@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The older single-gather methods as registry entries: upload -> CoC pass -> one gather pass ->
 // read back. Each owns its targets (reallocated only when size or format changes).
 #pragma once

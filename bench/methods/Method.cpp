@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The method registry, the half-resolution wrapper and the wall clock shared by every method.
 #include "bench/methods/Method.hpp"
 

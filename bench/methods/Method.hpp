@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The registry of depth-of-field methods that the accuracy benchmark compares: each method is a
 // named chain of passes (or the CPU reference) behind one interface, with the same knobs (sample
 // count, resolution scale, render-target precision) and the same output: linear float colour,

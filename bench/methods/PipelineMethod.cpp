@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Pipeline methods: one Pipeline run, read back as linear float, with this frame's GPU times.
 #include "bench/methods/PipelineMethod.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The filter's own chains (defocus::Pipeline) as registry entries: "mcintosh" (McIntosh et al.
 // 2012, min() of two rhombi), "rhombi" (three one-sided rhombi summed), each also with its
 // foreground handling ("-near"). QualitySettings come from the method name and settings.

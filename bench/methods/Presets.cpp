@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The product's presets as registry methods, and the figures the accuracy benchmark recorded.
 #include "bench/methods/Presets.hpp"
 

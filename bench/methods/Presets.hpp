@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The product's quality presets (filter/Presets.hpp) as methods of the benchmark's registry, with
 // the figures the accuracy benchmark recorded for each (docs/accuracy.md has the table they were
 // chosen from and the command that measures it).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Reference method: filled depth -> CoC map -> exact polygon scatter, all on the CPU.
 #include "bench/methods/ReferenceMethod.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // "reference" and "reference-pointy": the CPU scatter (ReferenceScatter.hpp) as registry entries,
 // with the filter's CoC model and input conventions.
 #pragma once

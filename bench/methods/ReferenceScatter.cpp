@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Exact-coverage aperture-polygon scatter with per-pixel depth layering (see ReferenceScatter.hpp).
 #include "bench/methods/ReferenceScatter.hpp"
 

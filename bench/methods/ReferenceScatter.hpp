@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The CPU reference of the methods registry: every pixel scatters its aperture polygon with the
 // exact area it covers of each destination pixel, depth-ordered and normalised. The best a single
 // RGB-D layer can give; slow (seconds per 640x480 frame), and meant to be.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Calibration pass: draws calibration.frag over the whole target.
 #include "bench/passes/CalibrationPass.hpp"
 

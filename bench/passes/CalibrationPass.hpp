@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A fixed reference workload for timing regressions. Shader: calibration.frag.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Gaussian pass: the 25 offsets and normalised weights, one draw.
 #include "bench/passes/GaussianBlurPass.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The 5x5 Gaussian whose spread follows the distance from the plane in focus (the WebGL "Toy
 // Story" demo), one pass over the CoC pass's output. Shader: gaussian_blur.frag.
 #pragma once

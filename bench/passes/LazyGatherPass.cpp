@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Lazy gather pass: the eight points in texture space, the threshold, one draw.
 #include "bench/passes/LazyGatherPass.hpp"
 

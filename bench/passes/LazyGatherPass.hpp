@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The 8-point "lazy" gather with blurriness-difference rejection (GameStudio wiki), one pass over
 // the CoC pass's output. Shader: lazy_gather.frag.
 #pragma once

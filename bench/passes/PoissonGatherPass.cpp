@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Poisson gather pass: the 12 taps in texture space, the blurriness unit, one draw.
 #include "bench/passes/PoissonGatherPass.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Riguer, Tatarchuk & Isidoro's 12-tap Poisson gather with their bleeding rule, one pass over the
 // CoC pass's output. Shader: poisson_gather.frag.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // EGL device platform first (the device asked for, or CUDA's, or each in turn), Mesa surfaceless
 // next; OpenGL 4.5 core; no surface at all.
 #include "filter/gl/EglContext.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A headless OpenGL 4.5 core context through EGL, with no window system: the EGL device platform
 // first (what a headless NVIDIA GPU offers), then Mesa's surfaceless platform (llvmpipe on CI).
 // Which device: one asked for by index (defocus --egl-device N), else the GPU that CUDA sees first

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The GLSL sources from shaders/, compiled into the binary by cmake/EmbedShaders.cmake.
 #pragma once
 

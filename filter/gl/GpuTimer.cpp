@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Double-buffered GL_TIME_ELAPSED query pools.
 #include "filter/gl/GpuTimer.hpp"
 

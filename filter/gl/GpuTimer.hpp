@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // GPU time per pass from GL_TIME_ELAPSED queries, double-buffered: the results read after a
 // frame are those of the frame before, which the GPU has long finished, so reading them never
 // stalls the pipeline. With finishEachScope(true) (profiling), each scope instead waits for the

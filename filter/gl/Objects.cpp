@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // RAII GL object wrappers: creation with DSA (GL 4.5), deletion, debug labels.
 #include "filter/gl/Objects.hpp"
 

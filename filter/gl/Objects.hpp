@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Move-only RAII owners for GL objects. A default-constructed object is explicitly empty (id 0);
 // moving leaves the source empty. Each object can carry a debug label (GL_KHR_debug).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Shader preprocessing (includes, defines), compilation and linking with readable errors.
 #include "filter/gl/Program.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A linked GLSL program made from embedded shader files, with `#include "x.glsl"` resolved from
 // the embedded set and variants chosen by a `#define` preamble.
 #pragma once

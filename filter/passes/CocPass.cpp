@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // CoC pass: uploads the lens coefficients and draws coc.frag.
 #include "filter/passes/CocPass.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Pass 1: linear colour + signed CoC (pixels) in alpha, into a float target of the frame's size
 // or half or a quarter of it. Shader: coc.frag.
 #pragma once

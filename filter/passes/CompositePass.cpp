@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Composite pass: draws composite.frag over the two diagonal results (and the near field).
 #include "filter/passes/CompositePass.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Pass 5: the hexagon from the two results of the last blur pass: min() of the McIntosh diagonal
 // blurs (optionally with the foreground layer over it), or the sum of the rhombus pass's pair.
 // Shader: composite.frag.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Copy pass: copy.frag on the given tiles.
 #include "filter/passes/CopyPass.hpp"
 

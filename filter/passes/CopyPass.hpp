@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Copies a texture into a target on a set of tiles: in-focus tiles skip the blur. Shader: copy.frag.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Directional blur pass: CPU-computed, aspect-corrected tap offsets + the bleeding-fix constants.
 #include "filter/passes/HexBlurPass.hpp"
 

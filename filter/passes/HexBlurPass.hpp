@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // One directional blur of the McIntosh hexagonal bokeh (pass 2, 3 or 4). Shader: hex_blur.frag.
 #pragma once
 

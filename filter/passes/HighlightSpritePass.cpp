@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Bokeh sprites: one compute dispatch appends the sprites and counts them into the indirect draw
 // command in the same buffer, a second of one invocation empties the draw of a frame over its
 // budget, the CPU puts them in the order of their pixels; one instanced draw of hexagons adds

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Bokeh sprites for highlights: the light of blurred pixels brighter than a threshold, which the
 // CoC pass takes out of the gather, scattered as hexagons with exact edges and added to the
 // output. Runs only on frames with highlights. Shaders: highlight_sprites.comp (find them, on the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Lights in focus put back: the rhombus blur's lines as uniforms, one program per set of line
 // modes, an additive draw on the highlight tiles.
 #include "filter/passes/InFocusLightPass.hpp"

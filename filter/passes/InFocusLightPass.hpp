@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Lights in focus put back: the CoC pass lets a light in focus into the blur as what lies round
 // it (coc.frag, bokeh sprites' frames), and this pass adds the rest of it to the output, by the
 // share of the pixel that the blur left its own (under a blurred foreground, less). Shader:

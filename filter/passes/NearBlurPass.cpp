@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Near field blur pass: same tap offsets as the McIntosh blur, no bleeding rule (the layer holds
 // only foreground, premultiplied), radius from the dilated tile maxima.
 #include "filter/passes/NearBlurPass.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The foreground (near field) layer's directional blurs. Shader: near_blur.frag.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What every pass shares: a human-readable name (GL labels, logs, GPU timers) and the
 // full-screen triangle draw. Passes take explicit inputs and write the target they are given.
 #pragma once

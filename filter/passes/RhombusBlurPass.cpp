@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Rhombus blur pass: per-pass line directions in texture space, the bleeding constants shared
 // with the McIntosh blur, and the two-target draw.
 #include "filter/passes/RhombusBlurPass.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // One pass of the energy-conserving hexagon: three one-sided rhombi summed (shader
 // rhombus_blur.frag, where the decomposition is derived). Two passes and a composite make the
 // hexagon; each pass writes two targets.

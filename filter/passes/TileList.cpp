@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Tile instances: one ivec2 per tile in a vertex buffer, advanced once per instance.
 #include "filter/passes/TileList.hpp"
 

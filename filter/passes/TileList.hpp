@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A set of 16x16 tiles to draw as instances with shaders/tiles.vert, so a pass can run on the
 // tiles that need it and leave the others to a cheaper pass.
 #pragma once

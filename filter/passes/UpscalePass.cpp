@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Upscale pass: the CoC pass's lens parameters (the shader recomputes each pixel's CoC from the
 // frame's depth) and a draw over the frame-sized target.
 #include "filter/passes/UpscalePass.hpp"

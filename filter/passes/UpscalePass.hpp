@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Upscale (Resolution::Half): the frame-sized result from the half- or quarter-size blur, with the frame's
 // own pixels put back where they are in focus. Two draws: the half-size prefilter that keeps the
 // interpolation sharp (upscale_prefilter.frag), then the frame-sized upscale (upscale.frag).

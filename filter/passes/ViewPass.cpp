@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // View pass: draws view.frag with the chosen mode and range.
 #include "filter/passes/ViewPass.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Shows an intermediate target: colour as is, depth or signed CoC colour-mapped. Shader: view.frag.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The `defocus` element through GstHarness: colour and depth pushed, the result pulled and held
 // equal, byte for byte, to libdefocus on the same frame; passthrough, property changes,
 // keyframed focus, EOS on either pad, flushing, caps it refuses, the errors it posts, and one

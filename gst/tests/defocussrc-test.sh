@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The defocussrc element from the command line: gst-inspect-1.0 describes it cleanly; the bundled
 # TUM folder read by defocussrc (files named by timestamp, which multifilesrc cannot read) and
 # filtered by defocus gives the CLI's frames, byte for byte; num-buffers stops it; a missing input

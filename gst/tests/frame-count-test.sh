@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # One frame out per colour frame from the command line: the bundled TUM clip with frames taken out
 # of rgb.txt (a recording with gaps) through defocussrc ! defocus ! multifilesink gives one file
 # per colour frame, at a variable rate (framerate=0/1), where a mean rate made the aggregator fill

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The defocus element from the command line: gst-inspect-1.0 describes it cleanly, a gst-launch-1.0
 # pipeline over the bundled clip gives the same frames as the defocus CLI (decoded pixels, byte for
 # byte), and without OpenGL the pipeline fails with the element's message, not a crash.

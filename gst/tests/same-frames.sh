@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Sourced by the gst tests: same_frames_as_cli GST_DIR CLI_DIR WORK WHAT
 # GST_DIR holds a pipeline's frames as %06d.png, CLI_DIR the defocus CLI's folder output (frames
 # under the clip's TUM names, listed in rgb.txt). Both sets are decoded to raw RGB by the same

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // DEFOCUS_API marks what libdefocus exports; everything else in the library is hidden.
 #pragma once
 

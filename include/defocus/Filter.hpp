@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus::Filter: gives one colour frame + its depth the depth of field of a real lens, with
 // hexagonal bokeh, on a headless OpenGL 4.5 context of its own (a GPU, or Mesa llvmpipe).
 //   defocus::Settings s;  s.lens.focusM = 1.0;  s.lens.fNumber = 1.4;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Where libdefocus' messages go (a depth folder shorter than the colour, a codec that is missing,
 // a camera that gives another size than asked, ...): by default one line each on standard error,
 // "defocus: warning: ...", never on standard output, which stays the program's. A program or a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The settings of defocus::Filter: the lens, how focus is chosen, the quality, what is written.
 // Each field has its unit, range and default; names and ranges are the defocus command line's
 // (`defocus --help`), so `--f-number 1.4` is `settings.lens.fNumber = 1.4`.

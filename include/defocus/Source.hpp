@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus::Source: the command line's inputs as a stream of colour + depth frames, for programs
 // that want to read what `defocus INPUT` reads (GStreamer's defocussrc is one).
 //   defocus::Source source({"data/tum_fr1_rpy"});        // TUM folder: depth in metres, 5000 units/m

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The whole public API of libdefocus: find_package(defocus) + target defocus::defocus, or
 // pkg-config defocus. See Filter.hpp for the filter, Settings.hpp for what it takes and Source.hpp
 // for reading the inputs the command line reads, Log.hpp for where its messages go.

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The anchors of the accuracy corpus: for every scene folder, Blender's Defocus compositor node
 # (blender_defocus.py, calibrated) and GEGL's lens-blur driven by the thin-lens CoC of the
 # scene's depth, written as ANCHORS/SCENE/{blender-defocus,gegl-lens-blur}.exr (linear) for

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Turns one scene's raw renders (scenes.py) into a corpus scene folder that
 # `defocus-bench accuracy --scene DIR` reads, small enough to commit:
 #   color_linear.exr  pinhole colour, scene-linear, half float (PIZ), mantissa rounded to 7 bits

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Blender's Defocus compositor node on one corpus scene folder: the anchor the presets are held
 # against. Run inside Blender 3.4 (scripts/corpus/anchors.py runs it):
 #   blender -b --factory-startup --python scripts/corpus/blender_defocus.py -- SCENE_DIR OUT.exr

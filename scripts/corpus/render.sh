@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Renders the accuracy corpus with Blender (Debian 12: apt-get install blender) and assembles
 # each scene folder: scripts/corpus/scenes.py renders the pinhole input and SEEDS thin-lens
 # renders of SAMPLES samples each, scripts/corpus/assemble.py averages them into the truth and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Builds and renders the accuracy corpus' Cycles scenes: for one scene, a pinhole render (the
 # filter's input: colour and planar depth) or one thin-lens render (half of the truth), 640x480.
 # Run inside Blender (Debian 12's blender 3.4), normally through scripts/corpus/render.sh:

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Markdown tables for docs/accuracy.md from a corpus run's corpus.json (defocus-bench accuracy
 # --scene ... --anchors ...): linear PSNR per scene, min and median, and the share of the
 # squared error per zone.   scripts/corpus/table.py out/accuracy/corpus.json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The thin-lens CoC of a corpus scene's camera, as the filter computes it (filter/Lens.cpp,
 # thinLensCocPixels()), for the scripts that drive other tools with it (anchors.py). Plain
 # arithmetic: works on floats and on NumPy arrays alike; needs nothing beyond Python.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Filters one colour image + its 16-bit depth with libdefocus and writes the result as a PNG.
 //   defocus-consumer COLOR DEPTH DEPTH_SCALE FOCUS_M F_NUMBER PRESET OUT.png
 #include <cstdio>
