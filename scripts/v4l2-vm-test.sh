@@ -166,24 +166,28 @@ if [ -z "$cli" ]; then
   echo "v4l2-vm: no defocus binary given"; rc=1
 else
   # The command line on vivid (reloaded: the probe unplugged it), unplugged after 2 frames:
-  # exit 1 with the message, and the frames written so far complete on disk.
+  # exit 1 with the message, nothing under the output's name (the clip failed), and with
+  # --keep-partial the frames written so far complete on disk in out.partial/.
   rmmod vivid && modprobe vivid n_devs=1 node_types=0x1
   cat >/host/dev/shm/cli.sh <<'EOS'
 mkdir -p /dev/shm/out
-"$1" /dev/video0 -o /dev/shm/out/ >/dev/shm/cli.log 2>&1 &
+"$1" /dev/video0 --keep-partial -o /dev/shm/out/ >/dev/shm/cli.log 2>&1 &
 pid=$!
 n=0
-# Frames are PNGs at the top of the folder (depth/ and the TUM lists beside them).
-frames() { ls /dev/shm/out/*.png 2>/dev/null | wc -l; }
-while [ "$(frames)" -lt 2 ] && [ $n -lt 1500 ]; do sleep 0.2; n=$((n + 1)); done
+# Frames are PNGs at the top of a folder (depth/ and the TUM lists beside them); until the clip is
+# done they are written into the output folder's hidden .defocus.partial/.
+frames() { ls "$1"/*.png 2>/dev/null | wc -l; }
+while [ "$(frames /dev/shm/out/.defocus.partial)" -lt 2 ] && [ $n -lt 1500 ]; do sleep 0.2; n=$((n + 1)); done
 v4l2-ctl -d /dev/video0 -c disconnect=1
 wait $pid
 status=$?
-tr '\r' '\n' </dev/shm/cli.log | grep -v '^frame' | sed 's/^/  /'
+tr '\r' '\n' </dev/shm/cli.log | grep -v '^frame' | grep -v ' frames, .* fps' | sed 's/^/  /'
 complete=0
-for f in /dev/shm/out/*.png; do tail -c 12 "$f" | grep -q IEND && complete=$((complete + 1)); done
-echo "  defocus exit $status; $(frames) frames kept, $complete of them complete PNGs"
-[ $status = 1 ] && [ $complete -ge 2 ] && [ $complete = "$(frames)" ] &&
+for f in /dev/shm/out.partial/*.png; do tail -c 12 "$f" | grep -q IEND && complete=$((complete + 1)); done
+kept=$(frames /dev/shm/out.partial)
+final=$(frames /dev/shm/out)
+echo "  defocus exit $status; $kept frames kept in out.partial/, $complete of them complete PNGs; $final under the output's name"
+[ $status = 1 ] && [ $complete -ge 2 ] && [ $complete = "$kept" ] && [ "$final" = 0 ] &&
   grep -q 'disconnected after' /dev/shm/cli.log
 EOS
   run /bin/sh /dev/shm/cli.sh "$cli" || rc=1
