@@ -351,12 +351,12 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     double totalMs = 0, uploadMs = 0, readbackMs = 0;
     std::size_t framesIn = 0, timed = 0;
     bool sheetWritten = false;
-    std::size_t current = 0; // index of the frame being read or processed, for messages
+    std::size_t current = 0; // the input's frame being read or processed, counted as --start counts, for messages
 
     int status = kExitDone;
     try {
         while (!cli::stopRequested() && (!options.frames || framesIn < *options.frames)) {
-            current = framesIn;
+            current = read;
             std::optional<Frame> frame = source.next();
             if (!frame)
                 break;
@@ -428,7 +428,8 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         progress.finish();
         // A write that failed on the writing thread is rethrown frames later: name its frame.
         if (const auto* background = dynamic_cast<const BackgroundSink*>(&sink))
-            current = background->failedFrame().value_or(current);
+            if (const std::optional<std::size_t> written = background->failedFrame())
+                current = options.start + *written * options.every; // the k-th frame written, as read
         spdlog::error("frame {}: {}", current, error.what());
         status = cli::statusFor(error);
         if (report)
