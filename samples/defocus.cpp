@@ -351,6 +351,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     double totalMs = 0, uploadMs = 0, readbackMs = 0;
     std::size_t framesIn = 0, timed = 0;
     bool sheetWritten = false;
+    cv::Mat sheet; // --contact-sheet's image, once its frame has passed
     std::size_t current = 0; // the input's frame being read or processed, counted as --start counts, for messages
 
     int status = kExitDone;
@@ -402,7 +403,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
             }
             const cv::Mat image = filter.process(frame->color, frame->depth, frame->timestamp);
             if (!options.contactSheet.empty() && frame->index == options.contactFrame) {
-                writeImageAtomically(options.contactSheet, filter.contactSheet());
+                sheet = filter.contactSheet(); // written with the output, when the run is done
                 sheetWritten = true;
             }
             sink.writeFrame(image, *frame);
@@ -439,6 +440,12 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     const bool cameraEnded = cli::stopRequested() && source.isLive() && status == kExitDone;
     if (cli::stopRequested() && !cameraEnded)
         status = cli::stopStatus();
+    // checkAgainstTheClip refused it up front where the clip's length was known.
+    if (!options.contactSheet.empty() && !sheetWritten && status == kExitDone && !cli::stopRequested()) {
+        spdlog::error("--contact-frame {} is beyond the {} frames read: no contact sheet written to {}",
+                      options.contactFrame, read, options.contactSheet);
+        status = kExitBadInput;
+    }
     if (status == kExitDone && framesIn > 0) {
         try {
             sink.finish();
@@ -461,13 +468,21 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         timingLog.gpu(lastGpu, filter.lastFrame().index);
     for (const auto& pass : lastGpu)
         passMs[pass.name] += pass.ms;
-    if (!options.timings.empty() && framesIn > 0)
-        timingLog.write(options.timings, filter.renderer(), frameSize);
-    // checkAgainstTheClip refused it up front where the clip's length was known.
-    if (!options.contactSheet.empty() && !sheetWritten && status == kExitDone && !cli::stopRequested()) {
-        spdlog::error("--contact-frame {} is beyond the {} frames read: no contact sheet written to {}",
-                      options.contactFrame, read, options.contactSheet);
-        status = kExitBadInput;
+    // The contact sheet and the timings stand under their names only when the run is done, as
+    // the output does; --keep-partial keeps a failed or stopped run's under NAME.partial.EXT.
+    const bool done = status == kExitDone && framesIn > 0;
+    const auto sideFile = [&](const std::string& file) {
+        return done ? std::filesystem::path(file) : partialPath(file);
+    };
+    try {
+        if (sheetWritten && (done || options.keepPartial))
+            writeImageAtomically(sideFile(options.contactSheet), sheet);
+        if (!options.timings.empty() && framesIn > 0 && (done || options.keepPartial))
+            timingLog.write(sideFile(options.timings).string(), filter.renderer(), frameSize);
+    } catch (const std::exception& error) {
+        spdlog::error("{}", error.what());
+        if (status == kExitDone)
+            status = cli::statusFor(error);
     }
     const char* signalName = cli::stopSignal() == SIGINT ? "Ctrl-C" : "SIGTERM";
     if (cameraEnded && !options.quiet)

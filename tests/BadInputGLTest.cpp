@@ -86,8 +86,9 @@ std::string contents(const fs::path& file)
 // Defect caught: a clip that fails at a corrupt frame leaves its first frames under the output's
 // final name (a shorter video, a folder listing 5 of 10 frames, frame 4 as the image), where they
 // look like a finished result, and with -y in place of a good earlier output; or a temporary
-// file or folder left beside it. Each output kind: the error names the frame's file, exit 1, the
-// earlier output untouched, nothing else in its folder.
+// file or folder left beside it; and the same of the contact sheet and the timings beside a clip.
+// Each output kind: the error names the frame's file, exit 1, the earlier outputs untouched,
+// nothing else in their folder.
 TEST_F(BadInputCliGLTest, BrokenFrameMidClipLeavesTheEarlierOutputUntouched)
 {
     fs::path broken;
@@ -98,20 +99,27 @@ TEST_F(BadInputCliGLTest, BrokenFrameMidClipLeavesTheEarlierOutputUntouched)
     std::ofstream(out / "tb.png") << "an earlier good image";
     std::ofstream(out / "tb" / "rgb.txt") << "# an earlier good sequence\n1.0 1.png\n";
     std::ofstream(out / "tb" / "1.png") << "an earlier good frame";
+    std::ofstream(out / "sheet.png") << "an earlier good sheet";
+    std::ofstream(out / "t.json") << "earlier good timings";
     for (const std::string output : {"tb.mp4", "tb/", "tb.png"}) {
-        // One image holds one frame: the broken one, chosen with --start.
-        const std::string frames = output == "tb.png" ? "--start 5 --frames 1 " : "";
+        // One image holds one frame: the broken one, chosen with --start. A clip has its contact
+        // sheet (frame 2, before the broken one) and its timings beside it.
+        const std::string frames = output == "tb.png" ? "--start 5 --frames 1 "
+                                                      : fmt::format("--contact-sheet '{}' --contact-frame 2 --timings '{}' ",
+                                                                    (out / "sheet.png").string(), (out / "t.json").string());
         const CliResult r = runDefocus(fmt::format("'{}' --focus 1 --quality fast {}-y -o '{}'", clip.string(),
                                                    frames, (out / output).string()));
         EXPECT_EQ(r.exitCode, 1) << output << "\n" << r.output;
         // Named as the clip counts its frames, --start or not.
         EXPECT_NE(r.output.find("frame 5: cannot read colour image '" + broken.string()), std::string::npos)
             << r.output;
-        EXPECT_EQ(fileNames(out), (std::vector<std::string>{"tb", "tb.mp4", "tb.png"})) << output;
+        EXPECT_EQ(fileNames(out), (std::vector<std::string>{"sheet.png", "t.json", "tb", "tb.mp4", "tb.png"})) << output;
         EXPECT_EQ(fileNames(out / "tb"), (std::vector<std::string>{"1.png", "rgb.txt"})) << output;
     }
     EXPECT_EQ(contents(out / "tb.mp4"), "an earlier good video");
     EXPECT_EQ(contents(out / "tb.png"), "an earlier good image");
+    EXPECT_EQ(contents(out / "sheet.png"), "an earlier good sheet");
+    EXPECT_EQ(contents(out / "t.json"), "earlier good timings");
     EXPECT_EQ(contents(out / "tb" / "rgb.txt"), "# an earlier good sequence\n1.0 1.png\n");
 }
 
