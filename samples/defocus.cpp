@@ -350,7 +350,6 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     std::map<std::string, double> passMs;
     double totalMs = 0, uploadMs = 0, readbackMs = 0;
     std::size_t framesIn = 0, timed = 0;
-    bool sheetWritten = false;
     cv::Mat sheet; // --contact-sheet's image, once its frame has passed
     std::size_t current = 0; // the input's frame being read or processed, counted as --start counts, for messages
 
@@ -402,10 +401,8 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
                 settingsGiven = true;
             }
             const cv::Mat image = filter.process(frame->color, frame->depth, frame->timestamp);
-            if (!options.contactSheet.empty() && frame->index == options.contactFrame) {
+            if (!options.contactSheet.empty() && frame->index == options.contactFrame)
                 sheet = filter.contactSheet(); // written with the output, when the run is done
-                sheetWritten = true;
-            }
             sink.writeFrame(image, *frame);
             frameSize = image.size();
             const FrameReport& done = filter.lastFrame();
@@ -441,7 +438,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
     if (cli::stopRequested() && !cameraEnded)
         status = cli::stopStatus();
     // checkAgainstTheClip refused it up front where the clip's length was known.
-    if (!options.contactSheet.empty() && !sheetWritten && status == kExitDone && !cli::stopRequested()) {
+    if (!options.contactSheet.empty() && sheet.empty() && status == kExitDone && !cli::stopRequested()) {
         spdlog::error("--contact-frame {} is beyond the {} frames read: no contact sheet written to {}",
                       options.contactFrame, read, options.contactSheet);
         status = kExitBadInput;
@@ -475,7 +472,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
         return done ? std::filesystem::path(file) : partialPath(file);
     };
     try {
-        if (sheetWritten && (done || options.keepPartial))
+        if (!sheet.empty() && (done || options.keepPartial))
             writeImageAtomically(sideFile(options.contactSheet), sheet);
         if (!options.timings.empty() && framesIn > 0 && (done || options.keepPartial))
             timingLog.write(sideFile(options.timings).string(), filter.renderer(), frameSize);
