@@ -69,6 +69,27 @@ fs::path temporaryPath(const fs::path& output, bool folder)
     return partial.parent_path() / fmt::format(".{}", partial.filename().string());
 }
 
+fs::path keepOrRemove(const fs::path& temporary, const fs::path& output, bool folder, bool keep, std::size_t written,
+                      std::string_view what)
+{
+    std::error_code ec;
+    if (!keep || written == 0) {
+        fs::remove_all(temporary, ec);
+        return {};
+    }
+    const fs::path kept = partialPath(output, folder);
+    if (folder)
+        fs::remove_all(kept, ec); // an earlier run's: a rename does not replace a folder
+    fs::rename(temporary, kept, ec);
+    if (ec) {
+        const std::string why = ec.message();
+        if (!folder)
+            fs::remove(temporary, ec);
+        throw SinkError(fmt::format("cannot keep the partial {} '{}': {}", what, kept.string(), why));
+    }
+    return kept;
+}
+
 void writeFileAtomically(const fs::path& file, const std::string& contents)
 {
     const fs::path partial =

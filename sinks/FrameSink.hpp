@@ -15,10 +15,12 @@
 // NAME.partial.EXT (NAME.partial/).
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include <opencv2/core.hpp>
@@ -116,6 +118,12 @@ std::filesystem::path partialPath(const std::filesystem::path& output, bool fold
 /// out.mp4 -> .out.partial.mp4, a folder out/ -> .out.partial (in the same folder as the final
 /// name, so that the rename is atomic).
 std::filesystem::path temporaryPath(const std::filesystem::path& output, bool folder = false);
+/// A file sink's abandon(keep) of what it wrote under `temporary` (`written` frames): removes it,
+/// or with `keep` and a frame written renames it to partialPath(output, folder), replacing an
+/// earlier one, and returns that (else an empty path). A file that cannot be kept is removed; a
+/// folder's frames stay where they are. Throws SinkError "cannot keep the partial WHAT '...'".
+std::filesystem::path keepOrRemove(const std::filesystem::path& temporary, const std::filesystem::path& output,
+                                   bool folder, bool keep, std::size_t written, std::string_view what);
 
 /// Writes `contents` to `file` under a temporary name in the same folder and renames it into
 /// place, so no reader ever sees a half-written file. Throws SinkError naming the file.

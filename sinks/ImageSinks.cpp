@@ -259,18 +259,9 @@ fs::path ImageSequenceSink::abandon(bool keep)
     if (finished_)
         return {};
     finished_ = true;
-    std::error_code ec;
-    if (!keep || written_ == 0) {
-        fs::remove_all(work_, ec);
-        return {};
-    }
-    writeLists();
-    const fs::path kept = partialPath(folder_, true);
-    fs::remove_all(kept, ec); // an earlier run's
-    fs::rename(work_, kept, ec);
-    if (ec)
-        throw SinkError(fmt::format("cannot keep the partial sequence '{}': {}", kept.string(), ec.message()));
-    return kept;
+    if (keep && written_ > 0)
+        writeLists();
+    return keepOrRemove(work_, folder_, true, keep, written_, "sequence");
 }
 
 std::string ImageSequenceSink::describe() const
@@ -329,16 +320,7 @@ fs::path SingleImageSink::abandon(bool keep)
     if (finished_)
         return {};
     finished_ = true;
-    std::error_code ec;
-    if (!keep || written_ == 0) {
-        fs::remove(work_, ec);
-        return {};
-    }
-    const fs::path kept = partialPath(file_);
-    fs::rename(work_, kept, ec);
-    if (ec)
-        throw SinkError(fmt::format("cannot keep the partial image '{}': {}", kept.string(), ec.message()));
-    return kept;
+    return keepOrRemove(work_, file_, false, keep, written_, "image");
 }
 
 std::string SingleImageSink::describe() const

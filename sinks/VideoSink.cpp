@@ -262,19 +262,7 @@ fs::path VideoSink::abandon(bool keep)
         return {};
     finished_ = true;
     writer_.release();
-    std::error_code ec;
-    if (!keep || written_ == 0) {
-        fs::remove(partial_, ec);
-        return {};
-    }
-    const fs::path kept = partialPath(file_);
-    fs::rename(partial_, kept, ec);
-    if (ec) {
-        const std::string why = ec.message();
-        fs::remove(partial_, ec);
-        throw SinkError(fmt::format("cannot keep the partial video '{}': {}", kept.string(), why));
-    }
-    return kept;
+    return keepOrRemove(partial_, file_, false, keep, written_, "video");
 }
 
 std::string VideoSink::describe() const
