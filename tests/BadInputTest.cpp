@@ -18,10 +18,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
-#include <spdlog/sinks/ostream_sink.h>
-#include <spdlog/spdlog.h>
 
-#include "filter/Log.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/ImageHeader.hpp"
 #include "sources/ImageIO.hpp"
@@ -101,31 +98,6 @@ std::vector<std::string> fileNames(const fs::path& dir)
 }
 
 #define EXPECT_CONTAINS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
-
-/// Collects what the library logs (its own logger) and the program (spdlog's default) while it lives.
-class LogCapture {
-public:
-    LogCapture() : sink_(std::make_shared<spdlog::sinks::ostream_sink_mt>(stream_))
-    {
-        for (spdlog::logger* logger : loggers())
-            logger->sinks().push_back(sink_);
-    }
-    ~LogCapture()
-    {
-        for (spdlog::logger* logger : loggers()) {
-            auto& sinks = logger->sinks();
-            sinks.erase(std::remove(sinks.begin(), sinks.end(), sink_), sinks.end());
-        }
-    }
-    LogCapture(const LogCapture&) = delete;
-    LogCapture& operator=(const LogCapture&) = delete;
-    std::string text() const { return stream_.str(); }
-
-private:
-    static std::vector<spdlog::logger*> loggers() { return {spdlog::default_logger_raw(), &defocus::logger()}; }
-    std::ostringstream stream_;
-    std::shared_ptr<spdlog::sinks::ostream_sink_mt> sink_;
-};
 
 // ---- Images ------------------------------------------------------------------------------------
 
@@ -375,7 +347,7 @@ TEST(BadVideo, TruncatedMkvEndsEarlyWithAWarningNamingBothCounts)
     writeBytes(dir / "cut.mkv", bytes, bytes.size() * 6 / 10);
     const std::unique_ptr<FrameSource> source = openSource({dir / "cut.mkv", {}, {}});
     ASSERT_EQ(source->frameCount(), std::optional<std::size_t>(10));
-    LogCapture log;
+    test::LogCapture log;
     const std::vector<Frame> frames = readAll(*source);
     EXPECT_LT(frames.size(), 10u);
     EXPECT_CONTAINS(log.text(), fmt::format("video '{}': decoding stopped after {} of the 10 frames",

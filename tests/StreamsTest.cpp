@@ -16,10 +16,7 @@
 #include <linux/videodev2.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
-#include <spdlog/sinks/ostream_sink.h>
-#include <spdlog/spdlog.h>
 
-#include "filter/Log.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/PairedSource.hpp"
 #include "sources/V4l2Formats.hpp"
@@ -237,19 +234,12 @@ SourceOptions optionsFor(fs::path input, std::optional<fs::path> depth = std::nu
     return options;
 }
 
-/// What the library (its own logger) and spdlog's default logger log while `open` runs.
+/// What the library and the program log while `open` runs.
 std::string logOf(const std::function<void()>& open)
 {
-    std::ostringstream text;
-    const auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(text);
-    for (spdlog::logger* logger : {spdlog::default_logger_raw(), &defocus::logger()})
-        logger->sinks().push_back(sink);
+    const test::LogCapture log;
     open();
-    for (spdlog::logger* logger : {spdlog::default_logger_raw(), &defocus::logger()}) {
-        auto& sinks = logger->sinks();
-        sinks.erase(std::remove(sinks.begin(), sinks.end(), sink), sinks.end());
-    }
-    return text.str();
+    return log.text();
 }
 
 // Defect: a video with a depth folder or depth.txt announced as "no depth given; its frames pass

@@ -2,13 +2,19 @@
 // Helpers shared by the tests: where the bundled data lives, scratch folders, image statistics.
 #pragma once
 
+#include <algorithm>
 #include <filesystem>
+#include <memory>
 #include <ostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
+#include "filter/Log.hpp"
 #include "filter/Settings.hpp"
 
 namespace defocus::test {
@@ -47,5 +53,30 @@ std::vector<NamedQuality> presetsAndKernels();
 cv::Mat foregroundReach(const cv::Mat& signedCoc, int margin);
 /// True when every element of `m` (any depth, any channels) is finite.
 bool allFinite(const cv::Mat& m);
+
+/// Collects what the library logs (its own logger) and the program (spdlog's default) while it lives.
+class LogCapture {
+public:
+    LogCapture() : sink_(std::make_shared<spdlog::sinks::ostream_sink_mt>(stream_))
+    {
+        for (spdlog::logger* logger : loggers())
+            logger->sinks().push_back(sink_);
+    }
+    ~LogCapture()
+    {
+        for (spdlog::logger* logger : loggers()) {
+            auto& sinks = logger->sinks();
+            sinks.erase(std::remove(sinks.begin(), sinks.end(), sink_), sinks.end());
+        }
+    }
+    LogCapture(const LogCapture&) = delete;
+    LogCapture& operator=(const LogCapture&) = delete;
+    std::string text() const { return stream_.str(); }
+
+private:
+    static std::vector<spdlog::logger*> loggers() { return {spdlog::default_logger_raw(), &defocus::logger()}; }
+    std::ostringstream stream_;
+    std::shared_ptr<spdlog::sinks::ostream_sink_mt> sink_;
+};
 
 } // namespace defocus::test
