@@ -16,7 +16,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "filter/Frame.hpp"
+#include "defocus/Frame.hpp"
 #include "filter/SceneAnalysis.hpp"
 #include "filter/Settings.hpp"
 

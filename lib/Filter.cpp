@@ -298,7 +298,7 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
             throw InputError(problem);
     }
     frame.index = p.frames;
-    frame.timestamp = timestampS;
+    frame.timestampS = timestampS;
     frame.name = fmt::format("frame {}", p.frames);
 
     LensSettings lens = p.lens;

@@ -43,8 +43,7 @@ std::optional<SourceFrame> Source::next()
     }
     if (!frame)
         return std::nullopt;
-    return SourceFrame{std::move(frame->color), std::move(frame->depth), frame->timestamp, frame->index,
-                       std::move(frame->name)};
+    return frame;
 }
 
 std::optional<std::size_t> Source::frameCount() const

@@ -17,7 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "filter/Autofocus.hpp"
-#include "filter/Frame.hpp"
+#include "defocus/Frame.hpp"
 
 namespace defocus {
 

@@ -55,7 +55,7 @@ void FrameFeed::capture()
             std::optional<Frame> frame = source_.next();
             if (frame) {
                 const auto now = LiveClock::now();
-                const auto captured = captureTime(frame->timestamp, now);
+                const auto captured = captureTime(frame->timestampS, now);
                 fed = FedFrame{std::move(*frame), captured.value_or(now), captured.has_value()};
             }
         } catch (...) {

@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include "filter/Frame.hpp"
+#include "defocus/Frame.hpp"
 #include "sources/FrameSource.hpp"
 
 namespace defocus {

@@ -362,7 +362,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
                 break;
             const std::size_t position = read++;
             if (!firstTimestamp)
-                firstTimestamp = frame->timestamp;
+                firstTimestamp = frame->timestampS;
             if (position < options.start || (position - options.start) % options.every != 0)
                 continue; // --start, --every
             ++framesIn;
@@ -379,10 +379,10 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
             }
             // Seconds since the clip's first frame, for focus keys: its timestamps when it has
             // them, else the frame's index at the frame rate.
-            const bool stamped = *firstTimestamp > 0.0 && frame->timestamp > 0.0;
-            const double timeS = stamped ? frame->timestamp - *firstTimestamp : static_cast<double>(frame->index) / fps;
-            const double dtS = frameInterval(previousTimestamp, frame->timestamp, static_cast<double>(options.every) / fps);
-            previousTimestamp = frame->timestamp;
+            const bool stamped = *firstTimestamp > 0.0 && frame->timestampS > 0.0;
+            const double timeS = stamped ? frame->timestampS - *firstTimestamp : static_cast<double>(frame->index) / fps;
+            const double dtS = frameInterval(previousTimestamp, frame->timestampS, static_cast<double>(options.every) / fps);
+            previousTimestamp = frame->timestampS;
             if (demo && options.focus == "auto") {
                 lens.focusM = demo->lensAt(frame->index).focusM; // the scene's focus pull
             } else if (!focus.isFixed()) {
@@ -400,7 +400,7 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
                 filter.setSettings(settings); // checked: by finishOptions, or above
                 settingsGiven = true;
             }
-            const cv::Mat image = filter.process(frame->color, frame->depth, frame->timestamp);
+            const cv::Mat image = filter.process(frame->color, frame->depth, frame->timestampS);
             if (!options.contactSheet.empty() && frame->index == options.contactFrame)
                 sheet = filter.contactSheet(); // written with the output, when the run is done
             sink.writeFrame(image, *frame);

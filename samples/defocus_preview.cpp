@@ -152,7 +152,7 @@ int run(const Options& o)
                 if (fed && !live) {
                     // The latency of a clip frame starts when it is read, or when it falls due
                     // if it had to wait for the clip's pace.
-                    const auto due = o.noPace ? readStart : pacer.wait(fed->frame.timestamp);
+                    const auto due = o.noPace ? readStart : pacer.wait(fed->frame.timestampS);
                     fed->origin = std::max(readStart, due);
                 }
                 if (fed && !depthChecked) {
@@ -163,8 +163,8 @@ int run(const Options& o)
                         spdlog::warn("{}", check.warning);
                 }
                 if (fed) {
-                    const double dt = frameInterval(previousTimestamp, fed->frame.timestamp, 1.0 / sourceFps);
-                    previousTimestamp = fed->frame.timestamp;
+                    const double dt = frameInterval(previousTimestamp, fed->frame.timestampS, 1.0 / sourceFps);
+                    previousTimestamp = fed->frame.timestampS;
                     if (controls.autofocus)
                         autofocus.update(fed->frame.depth, dt);
                     else

@@ -25,7 +25,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "filter/Frame.hpp"
+#include "defocus/Frame.hpp"
 
 namespace defocus {
 

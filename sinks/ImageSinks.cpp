@@ -171,7 +171,7 @@ void ImageSequenceSink::writeFrame(const cv::Mat& image, const Frame& origin)
     if (finished_)
         throw SinkError(fmt::format("cannot write sequence '{}': already finished", folder_.string()));
     const std::string stem = nameFor(origin);
-    Entry entry{origin.timestamp > 0.0 ? origin.timestamp : static_cast<double>(written_) / fps_,
+    Entry entry{origin.timestampS > 0.0 ? origin.timestampS : static_cast<double>(written_) / fps_,
                 stem + (linear_ ? ".exr" : ".png"), {}};
     const fs::path file = work_ / entry.color;
     checkFrame(image, encoding(), folder_ / entry.color);

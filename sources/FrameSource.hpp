@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "filter/Frame.hpp"
+#include "defocus/Frame.hpp"
 
 namespace defocus {
 

@@ -148,7 +148,7 @@ std::optional<std::size_t> DepthSequence::match(const Frame& color)
     if (pairing_.mode == DepthPairing::Mode::Index)
         return color.index < entries_.size() ? std::optional(color.index) : std::nullopt;
 
-    double t = color.timestamp;
+    double t = color.timestampS;
     if (pairing_.alignStarts) {
         if (!firstColorTime_)
             firstColorTime_ = t;
@@ -208,7 +208,7 @@ V4l2DepthStream::V4l2DepthStream(std::unique_ptr<V4l2Source> depth, double maxGa
 std::optional<DepthSample> V4l2DepthStream::depthFor(const Frame& color)
 {
     using std::chrono::milliseconds;
-    const double t = color.timestamp;
+    const double t = color.timestampS;
     const auto keep = [this](Frame frame) {
         recent_.push_back(std::move(frame));
         lastArrival_ = steadySeconds();
@@ -220,7 +220,7 @@ std::optional<DepthSample> V4l2DepthStream::depthFor(const Frame& color)
     while (std::optional<Frame> frame = depth_->nextWithin(milliseconds(0)))
         keep(std::move(*frame));
     const double waitUntil = steadySeconds() + maxGap_;
-    while (recent_.empty() || recent_.back().timestamp < t) {
+    while (recent_.empty() || recent_.back().timestampS < t) {
         const double left = waitUntil - steadySeconds();
         if (left <= 0.0)
             break;
@@ -235,9 +235,9 @@ std::optional<DepthSample> V4l2DepthStream::depthFor(const Frame& color)
 
     auto best = recent_.end();
     for (auto it = recent_.begin(); it != recent_.end(); ++it)
-        if (best == recent_.end() || std::abs(it->timestamp - t) < std::abs(best->timestamp - t))
+        if (best == recent_.end() || std::abs(it->timestampS - t) < std::abs(best->timestampS - t))
             best = it;
-    if (best == recent_.end() || std::abs(best->timestamp - t) > maxGap_)
+    if (best == recent_.end() || std::abs(best->timestampS - t) > maxGap_)
         return std::nullopt;
     DepthSample sample{best->depth.clone(), best->name};
     recent_.erase(recent_.begin(), best); // older ones are no nearer to any later colour frame

@@ -608,7 +608,7 @@ SyntheticImages SyntheticScene::render(std::size_t index, bool withReference)
     const std::vector<glm::dvec2> centre(s.pinholeJitter.size(), glm::dvec2(0.0));
     out.frame.color = s.accumulateRenders(out.lens, view, centre, s.pinholeJitter);
     out.frame.index = index;
-    out.frame.timestamp = static_cast<double>(index) / s.settings.frameRate;
+    out.frame.timestampS = static_cast<double>(index) / s.settings.frameRate;
     out.frame.name = fmt::format("synthetic/{}/{:04d}", s.scene.name, index);
 
     if (withReference) {

@@ -15,7 +15,7 @@
 #include <glm/vec3.hpp>
 #include <opencv2/core.hpp>
 
-#include "filter/Frame.hpp"
+#include "defocus/Frame.hpp"
 #include "filter/Settings.hpp"
 
 namespace defocus {

@@ -127,7 +127,7 @@ std::optional<Frame> TumSource::next()
         checkDepthFits(frame.color.size(), (folder_ / entry.rgb).string(), frame.depth.size(),
                        (folder_ / *entry.depth).string());
     }
-    frame.timestamp = entry.rgbTime;
+    frame.timestampS = entry.rgbTime;
     frame.index = next_;
     frame.name = entry.rgb.generic_string();
     ++next_;

@@ -487,7 +487,7 @@ bool V4l2Source::dequeue(std::optional<Frame>& frame)
         frame->depth = std::move(image);
     else
         frame->color = std::move(image);
-    frame->timestamp = believable ? driverTime : now;
+    frame->timestampS = believable ? driverTime : now;
     frame->index = delivered_++;
     frame->name = fmt::format("{}#{}", options_.device.filename().string(), frame->index);
     return true;

@@ -88,7 +88,7 @@ std::optional<Frame> VideoFileSource::next()
         frame.depth = depth_.clone(); // each frame owns its pixels
     }
     const double msec = capture_.get(cv::CAP_PROP_POS_MSEC);
-    frame.timestamp = std::isfinite(msec) && msec >= 0.0 ? msec / 1000.0
+    frame.timestampS = std::isfinite(msec) && msec >= 0.0 ? msec / 1000.0
                       : frameRate_ > 0.0                  ? static_cast<double>(next_) / frameRate_
                                                           : 0.0;
     frame.index = next_;

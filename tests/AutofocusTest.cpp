@@ -305,8 +305,8 @@ TEST(Autofocus, ConvergesToTheSubjectOfTheTumClip)
     cv::Mat lastDepth;
     std::size_t frames = 0;
     while (auto frame = source->next()) {
-        af.update(frame->depth, frameInterval(previous, frame->timestamp, 1.0 / 30));
-        previous = frame->timestamp;
+        af.update(frame->depth, frameInterval(previous, frame->timestampS, 1.0 / 30));
+        previous = frame->timestampS;
         lastDepth = frame->depth;
         ++frames;
     }

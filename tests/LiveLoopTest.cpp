@@ -34,7 +34,7 @@ public:
         Frame frame;
         frame.color = cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(static_cast<double>(index_ % 256)));
         frame.index = index_++;
-        frame.timestamp = std::chrono::duration<double>(LiveClock::now().time_since_epoch()).count();
+        frame.timestampS = std::chrono::duration<double>(LiveClock::now().time_since_epoch()).count();
         return frame;
     }
     bool isLive() const override { return live_; }

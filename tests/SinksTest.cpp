@@ -140,8 +140,8 @@ TEST(ImageSequenceSink, KeepsTheInputsFrameNamesAndIsATumFolderAgain)
     for (int k = 0; k < 2; ++k) {
         Frame origin;
         origin.index = static_cast<std::size_t>(k);
-        origin.timestamp = times[static_cast<std::size_t>(k)];
-        origin.name = fmt::format("rgb/{:.6f}.png", origin.timestamp);
+        origin.timestampS = times[static_cast<std::size_t>(k)];
+        origin.name = fmt::format("rgb/{:.6f}.png", origin.timestampS);
         origin.depth = cv::Mat(48, 64, CV_32FC1, cv::Scalar(1.0 + k)); // 1 m, then 2 m
         origin.depth.at<float>(0, 0) = 0.0f;                          // a hole stays a hole
         sink->writeFrame(testFrame(k), origin);
@@ -153,7 +153,7 @@ TEST(ImageSequenceSink, KeepsTheInputsFrameNamesAndIsATumFolderAgain)
     for (int k = 0; k < 2; ++k) {
         const std::optional<Frame> frame = again->next();
         ASSERT_TRUE(frame);
-        EXPECT_NEAR(frame->timestamp, times[static_cast<std::size_t>(k)], 1e-6);
+        EXPECT_NEAR(frame->timestampS, times[static_cast<std::size_t>(k)], 1e-6);
         EXPECT_EQ(cv::norm(frame->color, testFrame(k), cv::NORM_INF), 0.0);
         EXPECT_FLOAT_EQ(frame->depth.at<float>(10, 10), static_cast<float>(1 + k));
         EXPECT_FALSE(frame->depth.at<float>(0, 0) > 0.0f);

@@ -130,7 +130,7 @@ TEST(TumSource, BundledSequenceGivesAllTenPairsFromAssociations)
         const Frame& f = frames[i];
         EXPECT_EQ(f.index, i);
         EXPECT_EQ(f.name, expected[i].rgb);
-        EXPECT_DOUBLE_EQ(f.timestamp, expected[i].rgbTime);
+        EXPECT_DOUBLE_EQ(f.timestampS, expected[i].rgbTime);
         ASSERT_EQ(f.color.type(), CV_8UC3);
         EXPECT_EQ(f.color.size(), cv::Size(640, 480));
         ASSERT_EQ(f.depth.type(), CV_32FC1) << f.name;
@@ -180,7 +180,7 @@ TEST(TumSource, PairsEachColourFrameWithTheNearestDepthWithin20ms)
     for (int k = 0; k < syntheticFrames; ++k) {
         const Frame& f = frames[static_cast<std::size_t>(k)];
         EXPECT_EQ(f.name, fmt::format("rgb/{:.6f}.png", rgbTime(k)));
-        EXPECT_NEAR(f.timestamp, rgbTime(k), 1e-9);
+        EXPECT_NEAR(f.timestampS, rgbTime(k), 1e-9);
         EXPECT_EQ(f.color.at<cv::Vec3b>(0, 0)[0], 10 * k);
         if (k == frameWithoutDepth) {
             EXPECT_TRUE(f.depth.empty()) << f.name;

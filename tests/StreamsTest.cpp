@@ -276,7 +276,7 @@ TEST(VideoFileSource, ReadsAClipItWrote)
         EXPECT_EQ(frames[k].color.type(), CV_8UC3);
         EXPECT_NEAR(cv::mean(frames[k].color)[1], 20.0 * double(k), 3.0) << "MJPEG of a flat grey";
         EXPECT_TRUE(frames[k].depth.empty());
-        EXPECT_NEAR(frames[k].timestamp, double(k) / clipFps, 1e-3);
+        EXPECT_NEAR(frames[k].timestampS, double(k) / clipFps, 1e-3);
     }
 }
 
@@ -341,7 +341,7 @@ public:
             return std::nullopt;
         Frame frame;
         frame.color = cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(100));
-        frame.timestamp = times_[next_];
+        frame.timestampS = times_[next_];
         frame.index = next_;
         frame.name = fmt::format("colour#{}", next_++);
         return frame;
@@ -435,7 +435,7 @@ TEST(PairedSource, TumDepthListByTimestampMatchesTheBenchmarkAssociations)
         DepthSequence::fromList(tum / "depth.txt", 5000.0, pairing);
     for (std::size_t k = 0; k < rgbTimes.size(); ++k) {
         Frame colour;
-        colour.timestamp = rgbTimes[k];
+        colour.timestampS = rgbTimes[k];
         colour.index = k;
         const std::optional<DepthSample> sample = depth->depthFor(colour);
         ASSERT_TRUE(sample.has_value()) << k;

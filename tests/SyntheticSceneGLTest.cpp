@@ -377,7 +377,7 @@ TEST_F(SyntheticSceneGL, SourceYieldsTheClipAndThePullMovesTheFocus)
     while (auto frame = source.next()) {
         EXPECT_EQ(frame->index, count);
         EXPECT_EQ(frame->name, fmt::format("synthetic/spheres/{:04d}", count));
-        EXPECT_DOUBLE_EQ(frame->timestamp, static_cast<double>(count) / 30.0);
+        EXPECT_DOUBLE_EQ(frame->timestampS, static_cast<double>(count) / 30.0);
         EXPECT_EQ(frame->color.type(), CV_32FC3);
         EXPECT_EQ(frame->depth.type(), CV_32FC1);
         EXPECT_TRUE(test::allFinite(frame->color));

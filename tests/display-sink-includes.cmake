@@ -1,11 +1,11 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 # The window only shows frames: sinks/DisplaySink.hpp and .cpp may include of filter/ only the
-# frame and the logger, and nothing of samples/ (what a key does to the lens, the focus or the
+# logger, and nothing of samples/ (what a key does to the lens, the focus or the
 # view is samples/PreviewController's). Defect: the sink deciding keys, lens or focus again,
 # through filter/Pipeline.hpp, Autofocus.hpp, SceneAnalysis.hpp, Settings.hpp or the controller.
 #   cmake -DSOURCE_DIR=. -P tests/display-sink-includes.cmake      (CTest: display_sink_includes)
 cmake_minimum_required(VERSION 3.25)
-set(allowed filter/Frame.hpp filter/Log.hpp)
+set(allowed filter/Log.hpp)
 set(found 0)
 set(refused 0)
 foreach(file sinks/DisplaySink.hpp sinks/DisplaySink.cpp)

@@ -204,10 +204,10 @@ std::vector<Frame> capture(V4l2Source& source, int count)
 void expectIncreasingTimes(const std::vector<Frame>& frames, double rate)
 {
     for (std::size_t i = 1; i < frames.size(); ++i)
-        EXPECT_GT(frames[i].timestamp, frames[i - 1].timestamp) << "frame " << i;
+        EXPECT_GT(frames[i].timestampS, frames[i - 1].timestampS) << "frame " << i;
     // Single intervals vary under software emulation (a late frame is followed by a quick
     // one), but on average frames come at about the rate.
-    const double mean = (frames.back().timestamp - frames.front().timestamp) / double(frames.size() - 1);
+    const double mean = (frames.back().timestampS - frames.front().timestampS) / double(frames.size() - 1);
     EXPECT_GT(mean, 0.5 / rate);
     EXPECT_LT(mean, 3.0 / rate);
     std::printf("  mean frame interval %.1f ms (%.3g Hz asked)\n", mean * 1000.0, rate);

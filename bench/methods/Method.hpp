@@ -14,7 +14,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "filter/Frame.hpp"
+#include "defocus/Frame.hpp"
 #include "filter/Pipeline.hpp"
 #include "filter/Settings.hpp"
 

@@ -21,6 +21,7 @@
 
 #include "defocus/Export.hpp"
 #include "defocus/Filter.hpp"
+#include "defocus/Frame.hpp"
 
 namespace defocus {
 
@@ -46,20 +47,8 @@ struct SourceSettings {
     double fps = 30.0;
 };
 
-/// One frame as the source gives it.
-struct SourceFrame {
-    /// BGR, CV_8UC3 sRGB-encoded, or CV_32FC3 scene-linear (EXR and other float inputs).
-    cv::Mat color;
-    /// Metres along the view axis, CV_32FC1, its own size; 0 = no measurement; empty = no depth.
-    cv::Mat depth;
-    /// Capture time, seconds, on the source's clock (file names, TUM lists, a camera's
-    /// CLOCK_MONOTONIC); 0 where unknown.
-    double timestampS = 0.0;
-    /// Frames since the start, from 0.
-    std::size_t index = 0;
-    /// Where it came from, for messages, e.g. "rgb/1305031102.175304.png".
-    std::string name;
-};
+/// One frame as the source gives it (the same type Filter::process takes apart).
+using SourceFrame = Frame;
 
 class DEFOCUS_API Source {
 public:
