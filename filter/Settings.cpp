@@ -48,7 +48,7 @@ std::string_view viewName(View view)
 
 bool parseView(std::string_view name, View& view)
 {
-    return parseName(name, kAllViews, viewName, view);
+    return parseName(name, kAllViews, [](View v) { return viewName(v); }, view);
 }
 
 std::vector<SettingIssue> validate(LensSettings& lens, bool clamp)

@@ -4,6 +4,7 @@
 #include "defocus/Filter.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <utility>
@@ -138,6 +139,26 @@ RendererInfo probeRenderer(const ContextOptions& context)
     } catch (const gl::ContextError& error) {
         throw GlError(error.what());
     }
+}
+
+std::string_view viewName(Settings::View view)
+{
+    return viewName(toView(view));
+}
+
+std::optional<Settings::View> viewNamed(std::string_view name)
+{
+    return parseApiView(name);
+}
+
+std::string_view qualityName(Quality::Preset preset)
+{
+    return presetName(preset);
+}
+
+std::optional<Quality::Preset> qualityNamed(std::string_view name)
+{
+    return parsePreset(name);
 }
 
 std::string version()
@@ -362,6 +383,12 @@ void Filter::Impl::fillReport(std::size_t index)
     r.plan.invalidDepthFraction = p.pipeline->invalidDepthFraction();
     r.plan.nearField = plan.nearField;
     r.plan.highlightSprites = plan.highlightSprites;
+    r.plan.tileSizePx = SceneAnalysis::kTileSize;
+    r.plan.tileMap = cv::Mat::zeros(analysis.tiles, CV_8UC1);
+    if (analysis.tileMinCoc.size() == analysis.tiles) // a frame with no depth has no CoC ranges
+        for (int y = 0; y < analysis.tiles.height; ++y)
+            for (int x = 0; x < analysis.tiles.width; ++x)
+                r.plan.tileMap.at<std::uint8_t>(y, x) = analysis.tileNeedsBlur(x, y) ? 1 : 0;
     r.plan.explain = plan.explain(analysis);
 }
 

@@ -4,6 +4,10 @@
 // what the defocus program takes from it: the contact sheet, the last frame's GPU times, the
 // renderer and the device, and a preset resolved.
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <iterator>
+#include <limits>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -359,3 +363,78 @@ TEST(LibrarySettings, ResolveFillsThePresetsValues)
 }
 
 } // namespace
+
+// Defect caught: the tile map transposed, of the wrong size, or marking tiles that are only
+// copied (the preview's tile map would outline the sharp half of the frame).
+TEST_F(Library, TileMapMarksTheTilesTheBlurProcesses)
+{
+    // 100x60: a last column and row cut by the frame's edge. Left of x = 48 on the focus plane,
+    // right of it 4 m away at f/1.4: blurred by far more than half a pixel.
+    cv::Mat color(60, 100, CV_8UC3, cv::Scalar(90, 120, 150));
+    cv::Mat metres(color.size(), CV_32F, cv::Scalar(4.0f));
+    metres.colRange(0, 48).setTo(settings_.lens.focusM);
+    filter_->process(color, metres);
+    const defocus::Plan& plan = filter_->lastFrame().plan;
+    ASSERT_EQ(plan.tileSizePx, 16);
+    ASSERT_EQ(plan.tileMap.type(), CV_8UC1);
+    ASSERT_EQ(plan.tileMap.size(), cv::Size(7, 4));
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 7; ++x) {
+            // Tile 2 ends at x = 47; tile 3 starts at 48, the depth edge: blurred from there on.
+            const int expected = x >= 3 ? 1 : 0;
+            EXPECT_EQ(plan.tileMap.at<std::uint8_t>(y, x), expected) << "tile " << x << "," << y;
+        }
+    EXPECT_EQ(static_cast<std::size_t>(cv::countNonZero(plan.tileMap)), plan.blurTiles);
+}
+
+// Defect caught: a view or preset name that the command line's --view / --quality does not take
+// (the preview's HUD and the programs' reports print these words), or two views with one name.
+TEST(LibrarySettings, ViewAndQualityNamesAreTheCommandLines)
+{
+    const char* views[] = {"input", "horizontal", "diagonal-a", "diagonal-b", "composite", "depth", "coc"};
+    ASSERT_EQ(std::size(defocus::kViews), std::size(views));
+    for (std::size_t i = 0; i < std::size(views); ++i) {
+        EXPECT_EQ(defocus::viewName(defocus::kViews[i]), views[i]);
+        EXPECT_EQ(defocus::viewNamed(views[i]), defocus::kViews[i]);
+    }
+    EXPECT_EQ(defocus::viewNamed("Composite"), std::nullopt);
+    EXPECT_EQ(defocus::qualityName(defocus::Quality::Preset::Fast), "fast");
+    EXPECT_EQ(defocus::qualityName(defocus::Quality::Preset::High), "high");
+    EXPECT_EQ(defocus::qualityNamed("balanced"), defocus::Quality::Preset::Balanced);
+    EXPECT_EQ(defocus::qualityNamed("best"), std::nullopt);
+}
+
+// Defect caught: the public tracker ignoring its options (tap region, time constant), measuring
+// the centre after a tap, or the centre median counting holes as depth.
+TEST(LibraryFocus, TrackerMeasuresWhereItIsToldAndGlides)
+{
+    // 2 m everywhere, a 1 m object around (0.8, 0.3); holes (0) across the top rows.
+    cv::Mat metres(240, 320, CV_32F, cv::Scalar(2.0f));
+    metres(cv::Rect(246, 62, 20, 20)).setTo(1.0f);
+    metres.rowRange(0, 10).setTo(0.0f);
+    defocus::FocusTrackerOptions options;
+    options.timeConstantS = 0.5;
+    defocus::FocusTracker tracker(options, 3.0);
+    EXPECT_NEAR(tracker.update(metres, 1.0 / 30), 2.0, 1e-6) << "the first measurement is taken at once";
+    tracker.tap({256.0 / 320, 72.0 / 240}, 320.0 / 240);
+    EXPECT_TRUE(tracker.tapped());
+    EXPECT_NEAR(tracker.region().centre.x, 0.8, 1e-9);
+    tracker.update(metres, 1.0 / 30);
+    EXPECT_NEAR(tracker.targetM(), 1.0, 1e-6);
+    EXPECT_GT(tracker.focusM(), 1.5) << "one frame of a 0.5 s spring moves a little way";
+    for (int i = 0; i < 105; ++i) // 3.5 s = 7 time constants (99 % of a step takes 6.6): within 1 %
+        tracker.advance(1.0 / 30);
+    EXPECT_NEAR(1.0 / tracker.focusM(), 1.0, 0.01 * 0.5);
+    tracker.recentre();
+    EXPECT_FALSE(tracker.tapped());
+    EXPECT_TRUE(tracker.retarget(metres));
+    EXPECT_NEAR(tracker.targetM(), 2.0, 1e-6);
+    tracker.setFocus(std::numeric_limits<double>::infinity());
+    EXPECT_TRUE(std::isinf(tracker.focusM()));
+    EXPECT_TRUE(tracker.settled());
+
+    EXPECT_NEAR(defocus::medianCentreDepth(metres).value_or(0.0), 2.0, 1e-6);
+    EXPECT_EQ(defocus::medianCentreDepth(metres.rowRange(0, 10)), std::nullopt) << "holes only";
+    EXPECT_NEAR(defocus::secondsBetweenFrames(10.0, 10.04, 1.0 / 30), 0.04, 1e-12);
+    EXPECT_DOUBLE_EQ(defocus::secondsBetweenFrames(0.0, 10.04, 1.0 / 30), 1.0 / 30);
+}

@@ -80,6 +80,11 @@ struct Plan {
     double invalidDepthFraction = 0;  ///< share of the depth that had no measurement, [0, 1]
     bool nearField = false;           ///< the foreground's own blur ran
     bool highlightSprites = false;    ///< lights were scattered as hexagons
+    int tileSizePx = 16;              ///< side of a tile, pixels
+    /// One byte per tile (CV_8UC1, tiles across by tiles down, the last row and column possibly
+    /// cut by the frame's edge): 1 where the tile's blur reaches half a pixel, so the blur passes
+    /// process it, 0 where it is in focus and only copied. What the preview's tile map outlines.
+    cv::Mat tileMap;
     std::string explain;              ///< one line, as `defocus --explain` prints it
 };
 

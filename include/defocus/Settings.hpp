@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "defocus/Export.hpp"
@@ -130,6 +131,21 @@ struct Settings {
     /// TUM RGB-D uses 5000.
     double depthScale = 1000.0;
 };
+
+/// Every view, in --view's order (the preview's keys 1 to 7).
+inline constexpr Settings::View kViews[] = {Settings::View::Input,     Settings::View::Horizontal,
+                                            Settings::View::DiagonalA, Settings::View::DiagonalB,
+                                            Settings::View::Composite, Settings::View::Depth,
+                                            Settings::View::Coc};
+/// --view's word for `view`: "input", "horizontal", "diagonal-a", "diagonal-b", "composite",
+/// "depth" or "coc".
+DEFOCUS_API std::string_view viewName(Settings::View view);
+/// The view --view calls `name`; nullopt for any other word.
+DEFOCUS_API std::optional<Settings::View> viewNamed(std::string_view name);
+/// --quality's word for `preset`: "fast", "balanced" or "high".
+DEFOCUS_API std::string_view qualityName(Quality::Preset preset);
+/// The preset --quality calls `name`; nullopt for any other word.
+DEFOCUS_API std::optional<Quality::Preset> qualityNamed(std::string_view name);
 
 /// The range of each setting, {lowest, highest} allowed, as the command line's options, check()
 /// and the GStreamer element's properties take them.
