@@ -14,11 +14,8 @@
 #include <spdlog/spdlog.h>
 
 #include "defocus/Filter.hpp"
-#include "filter/ApiSettings.hpp"
-#include "filter/Log.hpp"
-#include "filter/gl/EglContext.hpp"
-#include "filter/gl/Program.hpp"
 #include "sources/FrameSource.hpp"
+#include "sources/IoLog.hpp"
 
 namespace defocus::cli {
 namespace {
@@ -115,8 +112,9 @@ void logToStderr(std::string_view program, bool quiet, bool verbose)
     spdlog::set_default_logger(logger);
     spdlog::set_pattern(fmt::format("%^{}: %l:%$ %v", program));
     spdlog::set_level(verbose ? spdlog::level::debug : quiet ? spdlog::level::warn : spdlog::level::info);
-    // The library's messages (its static parts linked into this program) the same way.
-    detail::setLogHandler(forwardLibraryLog, LogLevel::Debug);
+    // libdefocus' messages, and those of the sources and sinks linked into the program, the same way.
+    setLogHandler(forwardLibraryLog, LogLevel::Debug);
+    setIoLogHandler(forwardLibraryLog, LogLevel::Debug);
 }
 
 void forwardLibraryLog(LogLevel level, std::string_view message)
@@ -234,7 +232,7 @@ void addQualityOptions(CLI::App& app, Quality& quality, QualityNames& names)
 void finishQuality(const CLI::App& app, QualityNames& names, Quality& q)
 {
     // The names are checked by CLI11; the options given override the preset.
-    q.preset = parsePreset(names.qualityPreset).value_or(Quality::Preset::Balanced);
+    q.preset = qualityNamed(names.qualityPreset).value_or(Quality::Preset::Balanced);
     if (app.count("--precision") > 0)
         q.precision = names.precision == "32f" ? Quality::Precision::F32 : Quality::Precision::F16;
     if (app.count("--hexagon") > 0)
@@ -243,7 +241,7 @@ void finishQuality(const CLI::App& app, QualityNames& names, Quality& q)
         q.nearField = names.nearField;
     if (app.count("--resolution") > 0)
         q.resolution = names.resolution == "half" ? Quality::Resolution::Half : Quality::Resolution::Full;
-    q = resolveQuality(q);
+    q = resolve(q);
     names.precision = *q.precision == Quality::Precision::F32 ? "32f" : "16f";
     names.kernel = *q.hexagon == Quality::Hexagon::McIntosh ? "mcintosh" : "rhombi";
     names.resolution = *q.resolution == Quality::Resolution::Half ? "half" : "full";
@@ -257,11 +255,12 @@ void addDepthScaleOption(CLI::App& app, std::optional<double>& scale)
         ->check(positive());
 }
 
-std::optional<int> checkLensAndQuality(const LensSettings& lens, const QualitySettings& quality, bool autoFocus)
+std::optional<int> checkSettings(const Settings& settings)
 {
-    const auto issues = validateCommandLine(lens, quality, autoFocus);
+    Settings checked = settings;
+    const auto issues = check(checked);
     for (const auto& issue : issues)
-        spdlog::error("{}", issue.message);
+        spdlog::error("{}", issue);
     return issues.empty() ? std::nullopt : std::optional<int>(kExitUsage);
 }
 
@@ -297,8 +296,7 @@ void requestStop(int signal)
 
 int statusFor(const std::exception& error)
 {
-    if (dynamic_cast<const gl::ContextError*>(&error) || dynamic_cast<const gl::ShaderError*>(&error) ||
-        dynamic_cast<const GlError*>(&error) || dynamic_cast<const DeviceBusy*>(&error))
+    if (dynamic_cast<const GlError*>(&error) || dynamic_cast<const DeviceBusy*>(&error))
         return kExitUnavailable;
     return kExitBadInput;
 }

@@ -18,7 +18,6 @@
 
 #include <CLI/CLI.hpp>
 
-#include "filter/Settings.hpp"
 #include "defocus/Log.hpp"
 #include "defocus/Settings.hpp"
 #include "samples/ExitStatus.hpp"
@@ -34,7 +33,8 @@ std::optional<int> parse(CLI::App& app, int argc, char** argv);
 /// --version, which prints "PROGRAM VERSION": the project's version, CMake's PROJECT_VERSION.
 void addVersionFlag(CLI::App& app, std::string_view program);
 
-/// Sends every log line (spdlog's default logger, and the library's through forwardLibraryLog) to
+/// Sends every log line (spdlog's default logger; libdefocus' and the sources' and sinks' through
+/// forwardLibraryLog) to
 /// standard error as "PROGRAM: LEVEL: ..."; standard output keeps only results. quiet: warnings
 /// and errors only; verbose: debug too.
 void logToStderr(std::string_view program, bool quiet = false, bool verbose = false);
@@ -106,9 +106,10 @@ void finishQuality(const CLI::App& app, QualityNames& names, Quality& quality);
 /// --depth-scale, into `scale` (nullopt: the input's usual scale).
 void addDepthScaleOption(CLI::App& app, std::optional<double>& scale);
 
-/// Checks the lens and quality the command line gave (validateCommandLine): each problem is
-/// logged as an error and the result is kExitUsage; nullopt when there is none.
-std::optional<int> checkLensAndQuality(const LensSettings& lens, const QualitySettings& quality, bool autoFocus);
+/// Checks the settings the command line gave with defocus::check (an automatic focus, as
+/// AutofocusOptions::mode says, is checked once measured): each problem is logged as an error
+/// and the result is kExitUsage; nullopt when there is none.
+std::optional<int> checkSettings(const Settings& settings);
 
 /// Installs handlers for SIGINT and SIGTERM that only record the signal: the program stops
 /// reading, closes its outputs (defocus puts nothing under an output's name then, README "Exit
@@ -123,9 +124,9 @@ int stopStatus();
 /// Test hook: as if `signal` had arrived (0 clears it).
 void requestStop(int signal);
 
-/// The exit status for an error that ended a run: kExitUnavailable for no EGL display/GL 4.5
-/// context, a shader the driver refuses or a busy camera (a retry may work), kExitBadInput for
-/// everything else (the same input fails again).
+/// The exit status for an error that ended a run: kExitUnavailable for defocus::GlError (no EGL
+/// display or GL 4.5 context, a shader the driver refuses) or a busy camera (a retry may work),
+/// kExitBadInput for everything else (the same input fails again).
 int statusFor(const std::exception& error);
 
 } // namespace defocus::cli

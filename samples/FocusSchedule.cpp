@@ -9,7 +9,6 @@
 
 #include <fmt/format.h>
 
-#include "filter/DepthPrep.hpp"
 
 namespace defocus {
 namespace {
@@ -131,7 +130,7 @@ cv::Point2d parsePoint(std::string_view text)
     return {*x, *y};
 }
 
-FocusControl::FocusControl(const std::string& focus, std::optional<cv::Point2d> point, AutofocusSettings autofocus)
+FocusControl::FocusControl(const std::string& focus, std::optional<cv::Point2d> point, FocusTrackerOptions autofocus)
     : point_(point), autofocus_(autofocus)
 {
     if (focus == "auto") {
@@ -156,7 +155,7 @@ double FocusControl::measure(const Frame& frame) const
 {
     if (point_)
         return depthAtPoint(frame.depth, frame.color.size(), *point_).value_or(std::numeric_limits<double>::quiet_NaN());
-    return centreDepth(frame.depth, 0.1, std::numeric_limits<float>::quiet_NaN());
+    return medianCentreDepth(frame.depth, 0.1).value_or(std::numeric_limits<double>::quiet_NaN());
 }
 
 double FocusControl::focusFor(const Frame& frame, double timeS, double dtS)
@@ -191,7 +190,7 @@ std::string FocusControl::describe() const
     case Mode::Fixed: return fmt::format("fixed at {:g} m", fixedM_);
     case Mode::Auto: return fmt::format("auto: median depth of {} of the first frame", where);
     case Mode::Track:
-        return fmt::format("track: follows {} (time constant {:g} s)", where, autofocus_.settings().timeConstantS);
+        return fmt::format("track: follows {} (time constant {:g} s)", where, autofocus_.options().timeConstantS);
     case Mode::Keyed: return fmt::format("keyed: {} keys, eased in dioptres", schedule_.keys().size());
     }
     return {};

@@ -16,7 +16,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "filter/Autofocus.hpp"
+#include "defocus/Focus.hpp"
 #include "defocus/Frame.hpp"
 
 namespace defocus {
@@ -59,7 +59,7 @@ cv::Point2d parsePoint(std::string_view text);
 class FocusControl {
 public:
     /// `focus`: metres, 'inf', 'auto', 'track' or keys. Throws std::invalid_argument.
-    FocusControl(const std::string& focus, std::optional<cv::Point2d> point, AutofocusSettings autofocus = {});
+    FocusControl(const std::string& focus, std::optional<cv::Point2d> point, FocusTrackerOptions autofocus = {});
 
     /// The focus for `frame`, `timeS` seconds after the clip's first frame and `dtS` after the
     /// previous one. 'auto' measures the first frame with valid depth and keeps it.
@@ -78,7 +78,7 @@ private:
     std::optional<double> autoM_;
     FocusSchedule schedule_;
     std::optional<cv::Point2d> point_;
-    Autofocus autofocus_;
+    FocusTracker autofocus_;
     bool tracking_ = false;
 };
 

@@ -5,20 +5,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string_view>
 #include <utility>
 
 #include <fmt/format.h>
-
-#include "filter/Log.hpp"
+#include <spdlog/spdlog.h>
 
 namespace defocus {
 namespace {
 
 constexpr auto kMessageTime = std::chrono::seconds(4);
 
-int viewNumber(View view)
+int viewNumber(Settings::View view)
 {
     return static_cast<int>(view) + 1;
 }
@@ -35,11 +35,11 @@ double thirdStop(double n, int direction)
     return std::exp2((k + direction) / 6.0);
 }
 
-std::string rangeText(const LensSettings& lens)
+std::string rangeText(const Lens& lens)
 {
-    if (lens.model == CocModel::ThinLens)
+    if (lens.cocModel == Lens::Model::ThinLens)
         return "thin-lens";
-    return fmt::format("focal range {:.2f}-{:.2f} m", lens.nearLimitM, lens.farLimitM);
+    return fmt::format("focal range {:.2f}-{:.2f} m", lens.nearM, lens.farM);
 }
 
 /// Short GPU pass names so that one line holds them all at 560 px.
@@ -64,11 +64,11 @@ KeyOutcome applyKey(LiveControls& controls, int key, double focusM)
 {
     KeyOutcome outcome;
     outcome.handled = true;
-    LensSettings& lens = controls.lens;
+    Lens& lens = controls.lens;
     bool lensChanged = false;
     switch (key) {
     case '1': case '2': case '3': case '4': case '5': case '6': case '7':
-        controls.view = kAllViews[key - '1'];
+        controls.view = kViews[key - '1'];
         outcome.message = fmt::format("view {} {}", key - '0', viewName(controls.view));
         break;
     case '+': case '=':
@@ -86,13 +86,13 @@ KeyOutcome applyKey(LiveControls& controls, int key, double focusM)
         break;
     case 'j': // wider focal range: less blur (seed 003's keys)
     case 'l': // narrower: more blur
-        lens.model = CocModel::FocalRange;
+        lens.cocModel = Lens::Model::FocalRange;
         controls.nearRatio = key == 'j' ? controls.nearRatio / 1.25 : controls.nearRatio * 1.25;
         controls.farRatio = key == 'j' ? controls.farRatio * 1.25 : controls.farRatio / 1.25;
         lensChanged = true;
         break;
     case 'm':
-        lens.model = lens.model == CocModel::ThinLens ? CocModel::FocalRange : CocModel::ThinLens;
+        lens.cocModel = lens.cocModel == Lens::Model::ThinLens ? Lens::Model::FocalRange : Lens::Model::ThinLens;
         lensChanged = true;
         break;
     case 'f':
@@ -121,12 +121,12 @@ KeyOutcome applyKey(LiveControls& controls, int key, double focusM)
     }
     if (lensChanged) {
         // Judge the new values on the lens they will be used with, and keep the clamped ones.
-        const LensSettings used = lensFor(controls, focusM, &outcome.issues);
+        const Lens used = lensFor(controls, focusM, &outcome.issues);
         lens.fNumber = used.fNumber;
         lens.maxCocPx = used.maxCocPx;
-        if (used.model == CocModel::FocalRange && std::isfinite(used.focusM)) {
-            controls.nearRatio = used.nearLimitM / used.focusM;
-            controls.farRatio = used.farLimitM / used.focusM;
+        if (used.cocModel == Lens::Model::FocalRange && std::isfinite(used.focusM)) {
+            controls.nearRatio = used.nearM / used.focusM;
+            controls.farRatio = used.farM / used.focusM;
         }
         outcome.message = fmt::format("f/{}, max CoC {:.1f} px, {}", fNumberText(used.fNumber), used.maxCocPx,
                                       rangeText(used));
@@ -135,35 +135,37 @@ KeyOutcome applyKey(LiveControls& controls, int key, double focusM)
     return outcome;
 }
 
-LensSettings lensFor(const LiveControls& controls, double focusM, std::vector<SettingIssue>* issues)
+Lens lensFor(const LiveControls& controls, double focusM, std::vector<std::string>* issues)
 {
-    LensSettings lens = controls.lens;
+    Settings settings;
+    Lens& lens = settings.lens;
+    lens = controls.lens;
     lens.focusM = focusM;
     if (std::isfinite(focusM)) {
-        lens.nearLimitM = focusM * controls.nearRatio;
-        lens.farLimitM = focusM * controls.farRatio;
+        lens.nearM = focusM * controls.nearRatio;
+        lens.farM = focusM * controls.farRatio;
     } else {
-        lens.farLimitM = std::numeric_limits<double>::infinity();
+        lens.farM = std::numeric_limits<double>::infinity();
     }
-    auto found = validate(lens, true);
+    auto found = check(settings, true);
     if (issues)
         issues->insert(issues->end(), found.begin(), found.end());
     return lens;
 }
 
-Hud hudFor(const HudStatus& status, const SceneAnalysis* tileMap)
+Hud hudFor(const HudStatus& status, const Plan* tileMap)
 {
     Hud hud;
     hud.marks = {status.focusWindow.centre, status.focusWindow.size, status.autofocus};
     if (tileMap) {
-        const int s = SceneAnalysis::kTileSize;
-        for (int y = 0; y < tileMap->tiles.height; ++y)
-            for (int x = 0; x < tileMap->tiles.width; ++x)
-                if (tileMap->tileNeedsBlur(x, y))
+        const int s = tileMap->tileSizePx;
+        for (int y = 0; y < tileMap->tileMap.rows; ++y)
+            for (int x = 0; x < tileMap->tileMap.cols; ++x)
+                if (tileMap->tileMap.at<std::uint8_t>(y, x) != 0)
                     hud.outlines.emplace_back(x * s, y * s, s, s);
     }
 
-    const LensSettings& lens = status.lens;
+    const Lens& lens = status.lens;
     std::string focus = fmt::format("focus {:.2f} m [{}{}]", status.focusM, status.autofocus ? "auto" : "manual",
                                     status.tapped ? ", tapped" : "");
     if (std::abs(status.targetM - status.focusM) > 0.005 * status.focusM)
@@ -172,7 +174,7 @@ Hud hudFor(const HudStatus& status, const SceneAnalysis* tileMap)
     std::string gpu;
     for (const auto& pass : status.gpu)
         gpu += fmt::format("  {} {:.1f}", shortPassName(pass.name), pass.ms);
-    const FrameTimings& t = status.timings;
+    const Timings& t = status.timings;
     hud.lines = {
         fmt::format("{}   f/{}  {:.0f} mm  max CoC {:.1f} px  {}", focus, fNumberText(lens.fNumber), lens.focalLengthMm,
                     lens.maxCocPx, rangeText(lens)),
@@ -226,16 +228,16 @@ void PreviewController::handle(const WindowEvent& event, DisplaySink* window)
     }
     const KeyOutcome outcome = applyKey(controls_, event.key, focusForKeys_);
     if (!outcome.handled) {
-        logger().debug("key {} does nothing; keys: {}", event.key, kKeyHelp);
+        spdlog::debug("key {} does nothing; keys: {}", event.key, kKeyHelp);
         return;
     }
     for (const auto& issue : outcome.issues)
-        note(fmt::format("clamped: {}", issue.message), true);
+        note(fmt::format("clamped: {}", issue), true);
     if (outcome.issues.empty() && !outcome.message.empty())
         note(outcome.message, false);
 }
 
-Hud PreviewController::hud(const HudStatus& status, const SceneAnalysis* tileMap) const
+Hud PreviewController::hud(const HudStatus& status, const Plan* tileMap) const
 {
     if (!status.message.empty() || Clock::now() >= messageUntil_)
         return hudFor(status, tileMap);
@@ -248,9 +250,9 @@ Hud PreviewController::hud(const HudStatus& status, const SceneAnalysis* tileMap
 void PreviewController::note(std::string message, bool warning)
 {
     if (warning)
-        logger().warn("{}", message);
+        spdlog::warn("{}", message);
     else
-        logger().info("{}", message);
+        spdlog::info("{}", message);
     message_ = std::move(message);
     messageWarning_ = warning;
     messageUntil_ = Clock::now() + kMessageTime;

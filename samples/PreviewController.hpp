@@ -13,10 +13,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "filter/Autofocus.hpp"
-#include "filter/Pipeline.hpp"
-#include "filter/SceneAnalysis.hpp"
-#include "filter/Settings.hpp"
+#include "defocus/Filter.hpp"
+#include "defocus/Focus.hpp"
+#include "defocus/Settings.hpp"
 #include "sinks/DisplaySink.hpp"
 
 namespace defocus {
@@ -25,13 +24,13 @@ namespace defocus {
 /// the thread that runs the window (highgui is single-threaded), so it needs no lock.
 struct LiveControls {
     /// f-number, max CoC, model, focal length and sensor; focusM is not used (the focus comes
-    /// from Autofocus) and near/far come from the ratios below.
-    LensSettings lens;
+    /// from the FocusTracker) and nearM/farM come from the ratios below.
+    Lens lens;
     /// Focal-range model: near limit = focus * nearRatio, (0, 1). Default 0.5 (1 m at 2 m).
     double nearRatio = 0.5;
     /// Focal-range model: far limit = focus * farRatio, (1, +inf). Default 3 (6 m at 2 m).
     double farRatio = 3.0;
-    View view = View::Composite;
+    Settings::View view = Settings::View::Composite;
     /// Measure the focus region every frame (f). Off: the focus stays where it is, taps move it.
     bool autofocus = true;
     /// Outline the tiles that need blur (t).
@@ -58,19 +57,20 @@ inline constexpr const char* kKeyHelp =
 struct KeyOutcome {
     bool handled = false;
     std::string message;          ///< e.g. "f/2.8"; empty for keys with nothing to say
-    std::vector<SettingIssue> issues; ///< clamps, e.g. "--f-number must be between 0.7 and 64, not 71.8"
+    std::vector<std::string> issues; ///< clamps, e.g. "--f-number must be between 0.7 and 64, not 71.8"
 };
 
 /// Applies one key as cv::waitKey() returns it (ASCII; 27 = Esc). The f-number moves by 1/3
 /// stop (x 2^(1/6)) on the standard scale, max CoC by 2 px (0.5 px below 4 px), the focal range
 /// by x 1.25 each side (j wider, l narrower, switching to the focal-range model). Impossible
-/// values are clamped by validate(lens, true), judged at `focusM`, with the issue returned. 's'
+/// values are clamped by defocus::check(settings, true), judged at `focusM`, with the issue
+/// returned. 's'
 /// is PreviewController's (the window saves its picture), not handled here.
 KeyOutcome applyKey(LiveControls& controls, int key, double focusM);
 
 /// The lens for one frame: the controls with `focusM` and the focal-range limits from the
-/// ratios, clamped by validate(lens, true); what was clamped goes to `issues` when given.
-LensSettings lensFor(const LiveControls& controls, double focusM, std::vector<SettingIssue>* issues = nullptr);
+/// ratios, clamped by defocus::check(settings, true); what was clamped goes to `issues` when given.
+Lens lensFor(const LiveControls& controls, double focusM, std::vector<std::string>* issues = nullptr);
 
 /// What the HUD shows besides the controls.
 struct HudStatus {
@@ -78,9 +78,9 @@ struct HudStatus {
     double targetM = 2.0;      ///< where autofocus is heading, metres
     bool autofocus = true;
     bool tapped = false;       ///< the focus region is a tapped point, not the centre
-    FocusWindow focusWindow;   ///< drawn as corner marks on the frame
-    LensSettings lens;         ///< as used for the frame (after clamping)
-    View view = View::Composite;
+    FocusRegion focusWindow;   ///< drawn as corner marks on the frame
+    Lens lens;                 ///< as used for the frame (after clamping)
+    Settings::View view = Settings::View::Composite;
     double fps = 0.0;          ///< new frames shown per second, recent average
     double latencyMs = 0.0;    ///< capture (or read) to display, recent average
     std::size_t dropped = 0;   ///< live frames replaced before processing
@@ -88,16 +88,16 @@ struct HudStatus {
     bool paused = false;
     bool live = false;
     bool ended = false;        ///< a recorded source has no more frames; the last one is held
-    FrameTimings timings;
-    std::vector<PassTime> gpu; ///< last known GPU time per pass (timings.gpu arrives a frame late)
+    Timings timings;
+    std::vector<Timings::Pass> gpu; ///< last known GPU time per pass (timings.gpu arrives a frame late)
     std::string message;       ///< a transient line (the last key's effect or a warning)
     bool warning = false;      ///< `message` is a warning (drawn in orange)
 };
 
 /// The HUD the window draws for `status`: four lines of figures, then `message` or the key
 /// help; the focus window as marks (green while autofocus follows); when `tileMap` is given, the
-/// tiles that need blur as outlines.
-Hud hudFor(const HudStatus& status, const SceneAnalysis* tileMap = nullptr);
+/// tiles its Plan::tileMap marks as blurred as outlines.
+Hud hudFor(const HudStatus& status, const Plan* tileMap = nullptr);
 
 /// Serves the window's events: keys through applyKey ('s' saves a screenshot), a left click
 /// taps to focus there, a right click recentres, a closed window quits. Each effect is logged
@@ -114,7 +114,7 @@ public:
     void setFocusForKeys(double focusM) { focusForKeys_ = focusM; }
     /// hudFor(status, tileMap), with the last effect noted when `status` has no message of its own
     /// and the effect is under 4 s old.
-    Hud hud(const HudStatus& status, const SceneAnalysis* tileMap = nullptr) const;
+    Hud hud(const HudStatus& status, const Plan* tileMap = nullptr) const;
 
 private:
     using Clock = std::chrono::steady_clock;

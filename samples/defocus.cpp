@@ -8,9 +8,9 @@
 // go through the library's public API (defocus::Settings, defocus::Filter, include/defocus/): one
 // Filter, its GL context and shaders, is made once and serves several clips (--batch). The
 // command line's parsing (CLI11), the sources and the sinks are the tree's own, and so is the
-// focus control (FocusSchedule, over the pipeline's Autofocus) and --demo's synthetic source
-// (which takes the pipeline's lens type and renders in a GL context of its own). Results go to
-// standard output, diagnostics to standard error; the exit statuses are ExitStatus.hpp's.
+// focus control (FocusSchedule, over the public FocusTracker); --demo's synthetic scene is
+// libdefocus' (defocus::Source). Nothing of filter/ is included (the build checks it). Results
+// go to standard output, diagnostics to standard error; the exit statuses are ExitStatus.hpp's.
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -31,9 +31,9 @@
 #include <spdlog/spdlog.h>
 
 #include "defocus/Filter.hpp"
+#include "defocus/Focus.hpp"
 #include "defocus/Settings.hpp"
-#include "filter/ApiSettings.hpp"
-#include "filter/gl/EglContext.hpp"
+#include "defocus/Source.hpp"
 #include "samples/Batch.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
@@ -47,7 +47,6 @@
 #include "sources/DepthScale.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/ReadAheadSource.hpp"
-#include "sources/SyntheticSource.hpp"
 
 namespace {
 
@@ -72,7 +71,7 @@ struct Options : cli::LensNames, cli::QualityNames {
     std::size_t start = 0;             ///< input frames skipped first
     std::size_t every = 1;             ///< then every Nth input frame
     std::string focusPoint;            ///< --focus-point X,Y; "" = the centre
-    AutofocusSettings autofocus;       ///< --focus track: --tau
+    FocusTrackerOptions autofocus;     ///< --focus track: --tau
     double depthScaleUsed = 0.0;       ///< the scale the input is read at (for the plausibility check)
     SourceOptions camera;              ///< --size, --camera-fps, --pixel-format
     std::optional<double> fps;
@@ -204,16 +203,34 @@ private:
     std::vector<std::size_t> filterIndex_; ///< the filter's frame number of each of frames_
 };
 
-/// --demo: a synthetic scene's shot (docs/synthetic.md) through the command line's lens; with
-/// 'auto' focus, the focus follows the scene's focus pull.
-std::unique_ptr<SyntheticSource> openDemo(const Options& options)
-{
-    SyntheticSettings settings;
-    settings.frames = options.frames.value_or(60);
-    settings.lens = toLens(options.settings.lens); // --demo's synthetic source takes the pipeline's lens type
-    settings.focusPull = options.focus == "auto";
-    return std::make_unique<SyntheticSource>(syntheticScene(options.demoScene), settings);
-}
+/// --demo: a synthetic scene's shot (docs/synthetic.md) through the command line's lens, rendered
+/// by libdefocus (defocus::Source, in a GL context of its own); with 'auto' focus, the focus
+/// follows the scene's focus pull.
+class DemoSource final : public FrameSource {
+public:
+    explicit DemoSource(const Options& options) : source_(settingsFor(options)) {}
+    std::optional<Frame> next() override { return source_.next(); }
+    std::optional<std::size_t> frameCount() const override { return source_.frameCount(); }
+    double frameRate() const override { return source_.frameRate(); }
+    std::string describe() const override { return source_.describe(); }
+    /// The focus of the scene's pull at frame `index`; nullopt without a pull.
+    std::optional<double> sceneFocusM(std::size_t index) const { return source_.sceneFocusM(index); }
+
+private:
+    static SourceSettings settingsFor(const Options& options)
+    {
+        SourceSettings settings;
+        SyntheticClip clip;
+        clip.scene = options.demoScene;
+        clip.frames = options.frames.value_or(60);
+        clip.lens = options.settings.lens;
+        clip.focusPull = options.focus == "auto";
+        settings.synthetic = clip;
+        settings.context = contextOptions(options);
+        return settings;
+    }
+    defocus::Source source_;
+};
 
 /// What a clip's report says of it (--report, --batch): frames, the settings as resolved, the
 /// renderer, and the timings' p50/p95/max.
@@ -320,7 +337,7 @@ void checkAgainstTheClip(const Options& options, std::optional<std::size_t> coun
 /// SIGINT/SIGTERM or failed at an error abandons it: nothing is written there, and with
 /// --keep-partial the frames so far are kept under OUTPUT.partial (FrameSink.hpp). A camera has no
 /// end: SIGINT/SIGTERM ends its clip, which is then done.
-int processClip(const Options& options, FrameSource& source, SyntheticSource* demo, FrameSink& sink, Filter& filter,
+int processClip(const Options& options, FrameSource& source, const DemoSource* demo, FrameSink& sink, Filter& filter,
                 nlohmann::json* report)
 {
     const Settings::Output output =
@@ -381,10 +398,10 @@ int processClip(const Options& options, FrameSource& source, SyntheticSource* de
             // them, else the frame's index at the frame rate.
             const bool stamped = *firstTimestamp > 0.0 && frame->timestampS > 0.0;
             const double timeS = stamped ? frame->timestampS - *firstTimestamp : static_cast<double>(frame->index) / fps;
-            const double dtS = frameInterval(previousTimestamp, frame->timestampS, static_cast<double>(options.every) / fps);
+            const double dtS = secondsBetweenFrames(previousTimestamp, frame->timestampS, static_cast<double>(options.every) / fps);
             previousTimestamp = frame->timestampS;
-            if (demo && options.focus == "auto") {
-                lens.focusM = demo->lensAt(frame->index).focusM; // the scene's focus pull
+            if (const auto pulled = demo ? demo->sceneFocusM(frame->index) : std::nullopt) {
+                lens.focusM = *pulled; // the scene's focus pull
             } else if (!focus.isFixed()) {
                 lens.focusM = focus.focusFor(*frame, timeS, dtS);
                 if (framesIn == 1 && options.focus == "auto" && !options.quiet)
@@ -518,31 +535,10 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
     if (!options.timings.empty())
         refuseExisting(options.timings, options.overwrite);
 
-    // --demo renders its frames with GL in a context of its own, current on this thread for the
-    // whole run (the Filter binds its own for each call and puts this one back); declared before
-    // the source, so that it outlives it. It shares its EGL display with the filter's context but
-    // not the count of the display's users (libdefocus holds its own copy of the GL code), so the
-    // filter ends first, with the demo: the display is terminated once, by the last to end.
-    std::optional<gl::EglContext> demoContext;
-    struct EndFilterFirst {
-        std::optional<Filter>& filter;
-        const std::optional<gl::EglContext>& context;
-        ~EndFilterFirst()
-        {
-            if (context)
-                filter.reset();
-        }
-    } endFilterFirst{filter, demoContext};
     std::unique_ptr<FrameSource> source;
-    SyntheticSource* demo = nullptr;
+    DemoSource* demo = nullptr;
     if (options.demo) {
-        if (!filter)
-            filter.emplace(Settings{}, contextOptions(options));
-        gl::ContextOptions demoOptions;
-        if (options.eglDevice)
-            demoOptions.device = *options.eglDevice;
-        demoContext.emplace(gl::EglContext::create(demoOptions));
-        auto synthetic = openDemo(options);
+        auto synthetic = std::make_unique<DemoSource>(options);
         demo = synthetic.get();
         source = std::move(synthetic);
     } else {
@@ -576,7 +572,7 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
     // While the filter works, a file output is encoded and written up to two frames behind and a
     // recorded clip decoded up to two ahead, each on a thread of its own (docs/benchmarks.md,
     // "Reading and writing beside the filter"); not a virtual camera's frames (due when made), nor
-    // --demo's (rendered in the filter's GL context, on this thread).
+    // --demo's (rendered on the GPU the filter uses, one call after the other).
     const bool virtualCamera = dynamic_cast<V4l2OutputSink*>(sink.get()) != nullptr;
     if (!virtualCamera)
         sink = std::make_unique<BackgroundSink>(std::move(sink));
@@ -619,7 +615,7 @@ void declareOptions(CLI::App& app, Options& o)
     cli::addLensOptions(app, o.settings.lens, o, cli::FocalRange::Fixed);
     cli::addQualityOptions(app, o.settings.quality, o);
     std::vector<std::string> views;
-    for (const View v : kAllViews)
+    for (const Settings::View v : kViews)
         views.emplace_back(viewName(v));
     app.add_option("--view", o.view, "What to write: " + fmt::format("{}", fmt::join(views, ", ")))
         ->check(CLI::IsMember(views))
@@ -646,7 +642,7 @@ void declareOptions(CLI::App& app, Options& o)
                  "No INPUT: render a synthetic clip (60 frames, a focus pull; --frames sets its length) and blur "
                  "it; the lens options drive its camera too");
     app.add_option("--demo-scene", o.demoScene, "Scene for --demo: spheres or edges")
-        ->check(CLI::IsMember(syntheticSceneNames()))
+        ->check(CLI::IsMember(syntheticScenes()))
         ->capture_default_str();
     app.add_flag("-q,--quiet", o.quiet, "Only the summary line and errors");
     app.add_flag("-v,--verbose", o.verbose, "Debug logging");
@@ -721,7 +717,7 @@ std::optional<int> finishOptions(const CLI::App& app, Options& o)
     }
     cli::finishQuality(app, o, o.settings.quality);
     cli::finishLens(o, o.settings.lens);
-    o.settings.view = parseApiView(o.view).value_or(Settings::View::Composite); // checked by CLI11
+    o.settings.view = viewNamed(o.view).value_or(Settings::View::Composite); // checked by CLI11
     try {
         std::optional<cv::Point2d> point;
         if (!o.focusPoint.empty())
@@ -915,7 +911,6 @@ int main(int argc, char** argv)
     if (const auto status = cli::parse(app, argc, argv))
         return *status;
     cli::logToStderr("defocus", o.quiet, o.verbose);
-    defocus::setLogHandler(cli::forwardLibraryLog, defocus::LogLevel::Debug); // libdefocus' as well
 
     try {
         if (const auto status = checkBatchOptions(app, o))

@@ -20,12 +20,9 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "filter/ApiSettings.hpp"
-#include "filter/Autofocus.hpp"
-#include "filter/Pipeline.hpp"
-#include "filter/Presets.hpp"
-#include "filter/Settings.hpp"
-#include "filter/gl/EglContext.hpp"
+#include "defocus/Filter.hpp"
+#include "defocus/Focus.hpp"
+#include "defocus/Settings.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
 #include "samples/LiveLoop.hpp"
@@ -39,22 +36,20 @@ namespace {
 
 using namespace defocus;
 
-/// The command line. The lens and quality options (lensGiven, qualityGiven and their names:
-/// model, fov, nearM, farM, qualityPreset, ...) are the ones every program shares
-/// (samples/CliOptions.hpp), --quality the balanced preset by default as defocus's; `lens` and
-/// `quality` are the pipeline's, made from them.
+/// The command line. The lens and quality options (lens, quality and their names: model, fov,
+/// nearM, farM, qualityPreset, ...) are the ones every program shares (samples/CliOptions.hpp),
+/// --quality the balanced preset by default as defocus's. The filtering goes through the public
+/// API (include/defocus/), as any program's would.
 struct Options : cli::LensNames, cli::QualityNames {
-    Lens lensGiven;
-    Quality qualityGiven;
-    LensSettings lens;
-    QualitySettings quality;
+    Lens lens;
+    Quality quality;
     std::string input;
     std::string depth;
     std::optional<double> depthScale;
     SourceOptions camera; ///< --size, --camera-fps, --pixel-format
     std::string focus = "auto";
     std::string view = "composite";
-    AutofocusSettings autofocus;
+    FocusTrackerOptions autofocus;
     std::optional<std::size_t> frames;
     bool loop = false;
     bool exitAtEnd = false;
@@ -71,9 +66,28 @@ bool isVideoDevice(const std::string& path)
     return path.rfind("/dev/video", 0) == 0;
 }
 
-std::string modelName(CocModel model)
+std::string modelName(Lens::Model model)
 {
-    return model == CocModel::ThinLens ? "thin-lens" : "focal-range";
+    return model == Lens::Model::ThinLens ? "thin-lens" : "focal-range";
+}
+
+/// --focus: 'auto' (nullopt), 'inf' or metres; false for anything else.
+bool parseFocus(const std::string& text, std::optional<double>& focusM)
+{
+    focusM.reset();
+    if (text == "auto")
+        return true;
+    if (text == "inf" || text == "infinity") {
+        focusM = std::numeric_limits<double>::infinity();
+        return true;
+    }
+    try {
+        std::size_t used = 0;
+        focusM = std::stod(text, &used);
+        return used == text.size();
+    } catch (const std::logic_error&) {
+        return false;
+    }
 }
 
 int run(const Options& o)
@@ -101,9 +115,9 @@ int run(const Options& o)
 
     LiveControls controls;
     controls.lens = o.lens; // finishLens has set its model and field of view
-    parseView(o.view, controls.view); // checked by CLI11
+    controls.view = viewNamed(o.view).value_or(Settings::View::Composite); // checked by CLI11
     controls.autofocus = o.focus == "auto";
-    Autofocus autofocus(o.autofocus);
+    FocusTracker autofocus(o.autofocus);
     if (!controls.autofocus)
         autofocus.setFocus(o.lens.focusM);
     // The focal range follows the focus, keeping the ratios given at the start.
@@ -117,18 +131,19 @@ int run(const Options& o)
     std::unique_ptr<DisplaySink> display;
     if (!o.noWindow)
         display = std::make_unique<DisplaySink>(DisplayOptions{"defocus-preview", o.screenshotDir});
-    auto context = gl::EglContext::create();
-    Pipeline pipeline;
+    Settings settings; // the lens and view of each frame from the controls; the focus is the tracker's
+    settings.quality = o.quality;
+    Filter filter(settings);
     if (!o.quiet)
         spdlog::info("{} ({}) on {}; keys: {}", source->describe(), live ? "live: newest frame, drops counted"
                                                                          : "recorded: every frame",
-                     context.info().glRenderer, kKeyHelp);
+                     filter.renderer(), kKeyHelp);
 
     auto feed = std::make_unique<FrameFeed>(*source, live);
     Pacer pacer(1.0 / sourceFps);
     LiveStats stats;
     std::optional<FedFrame> current;
-    std::vector<PassTime> gpu;
+    std::vector<Timings::Pass> gpu;
     std::size_t framesShown = 0, pipelineFrames = 0, renders = 0;
     double pipelineMs = 0.0;
     double previousTimestamp = 0.0;
@@ -163,7 +178,7 @@ int run(const Options& o)
                         spdlog::warn("{}", check.warning);
                 }
                 if (fed) {
-                    const double dt = frameInterval(previousTimestamp, fed->frame.timestampS, 1.0 / sourceFps);
+                    const double dt = secondsBetweenFrames(previousTimestamp, fed->frame.timestampS, 1.0 / sourceFps);
                     previousTimestamp = fed->frame.timestampS;
                     if (controls.autofocus)
                         autofocus.update(fed->frame.depth, dt);
@@ -236,18 +251,22 @@ int run(const Options& o)
                 continue;
             }
             forceRender = false;
-            std::vector<SettingIssue> issues;
-            const LensSettings lens = lensFor(controls, autofocus.focusM(), &issues);
+            std::vector<std::string> issues;
+            const Lens lens = lensFor(controls, autofocus.focusM(), &issues);
             std::string issueText;
             for (const auto& issue : issues)
-                issueText += (issueText.empty() ? "" : "; ") + issue.message;
+                issueText += (issueText.empty() ? "" : "; ") + issue;
             if (issueText != lastIssues && !issueText.empty())
                 spdlog::warn("clamped: {}", issueText);
             lastIssues = issueText;
 
-            pipeline.process(current->frame, lens, o.quality);
-            const cv::Mat image = pipeline.read(controls.view, Encoding::Srgb8);
-            const FrameTimings& timings = pipeline.timings();
+            settings.lens = lens;
+            settings.view = controls.view;
+            filter.setSettings(settings); // clamped by lensFor
+            const Frame& frame = current->frame;
+            const cv::Mat image = filter.process(frame.color, frame.depth, frame.timestampS);
+            const FrameReport& report = filter.lastFrame();
+            const Timings& timings = report.timings;
             if (!timings.gpu.empty())
                 gpu = timings.gpu;
             renderedRevision = controls.revision;
@@ -258,7 +277,7 @@ int run(const Options& o)
                 status.targetM = autofocus.targetM();
                 status.autofocus = controls.autofocus;
                 status.tapped = autofocus.tapped();
-                status.focusWindow = autofocus.window();
+                status.focusWindow = autofocus.region();
                 status.lens = lens;
                 status.view = controls.view;
                 status.fps = stats.recentFps();
@@ -275,7 +294,7 @@ int run(const Options& o)
                     status.warning = true;
                 }
                 controller.setFocusForKeys(autofocus.focusM());
-                display->setHud(controller.hud(status, controls.tileMap ? &pipeline.analysis() : nullptr));
+                display->setHud(controller.hud(status, controls.tileMap ? &report.plan : nullptr));
                 display->write(image);
                 controller.serve(*display);
             }
@@ -318,10 +337,10 @@ int run(const Options& o)
                 framesShown, feed->dropped(), renders, stats.fps(), origin, end, stats.latencyPercentileMs(0.5),
                 stats.latencyPercentileMs(0.95), stats.latencyPercentileMs(1.0),
                 pipelineFrames ? pipelineMs / static_cast<double>(pipelineFrames) : 0.0);
-    const LensSettings lens = lensFor(controls, autofocus.focusM());
+    const Lens lens = lensFor(controls, autofocus.focusM());
     std::printf("defocus-preview: final focus %.3f m (%s, target %.3f m), f/%.2f, max CoC %.1f px, %s, view %s\n",
                 autofocus.focusM(), controls.autofocus ? "auto" : "manual", autofocus.targetM(), lens.fNumber,
-                lens.maxCocPx, modelName(lens.model).c_str(), std::string(viewName(controls.view)).c_str());
+                lens.maxCocPx, modelName(lens.cocModel).c_str(), std::string(viewName(controls.view)).c_str());
     std::fflush(stdout);
     return exitCode;
 }
@@ -346,10 +365,10 @@ int main(int argc, char** argv)
     app.add_option("--focus", o.focus,
                    "'auto' (autofocus on; click to focus) or a distance in metres / 'inf' (autofocus off)")
         ->capture_default_str();
-    cli::addLensOptions(app, o.lensGiven, o, cli::FocalRange::FollowsFocus);
-    cli::addQualityOptions(app, o.qualityGiven, o);
+    cli::addLensOptions(app, o.lens, o, cli::FocalRange::FollowsFocus);
+    cli::addQualityOptions(app, o.quality, o);
     std::vector<std::string> views;
-    for (const View v : kAllViews)
+    for (const Settings::View v : kViews)
         views.emplace_back(viewName(v));
     app.add_option("--view", o.view, "View at the start: " + fmt::format("{}", fmt::join(views, ", ")))
         ->check(CLI::IsMember(views))
@@ -378,23 +397,28 @@ int main(int argc, char** argv)
     cli::logToStderr("defocus-preview", o.quiet, o.verbose);
 
     try {
-        cli::finishQuality(app, o, o.qualityGiven);
-        cli::finishLens(o, o.lensGiven);
-        o.lens = toLens(o.lensGiven);
-        o.quality = toQuality(o.qualityGiven);
-        bool autoFocus = false;
-        if (!parseFocus(o.focus, o.lens, autoFocus)) {
+        cli::finishQuality(app, o, o.quality);
+        cli::finishLens(o, o.lens);
+        std::optional<double> focusM;
+        if (!parseFocus(o.focus, focusM)) {
             spdlog::error("--focus '{}' is not a distance in metres, 'inf' or 'auto'", o.focus);
             return kExitUsage;
         }
+        if (focusM)
+            o.lens.focusM = *focusM;
         // --near and --far are checked at the starting focus (2 m with auto or inf), where run()
         // takes their ratios to the focus from.
         const double startM = std::isfinite(o.lens.focusM) ? o.lens.focusM : 2.0;
         const LiveControls defaults;
-        o.lens.nearLimitM = o.nearM.value_or(defaults.nearRatio * startM);
-        o.lens.farLimitM = o.farM.value_or(defaults.farRatio * startM);
+        o.lens.nearM = o.nearM.value_or(defaults.nearRatio * startM);
+        o.lens.farM = o.farM.value_or(defaults.farRatio * startM);
         // The command line is checked strictly, like defocus's; keys later clamp with a warning.
-        if (const auto status = cli::checkLensAndQuality(o.lens, o.quality, autoFocus))
+        Settings given;
+        given.lens = o.lens;
+        given.quality = o.quality;
+        if (!focusM)
+            given.autofocus.mode = AutofocusOptions::Mode::FirstFrame; // the focus is checked once measured
+        if (const auto status = cli::checkSettings(given))
             return *status;
         return run(o);
     } catch (const std::exception& error) {

@@ -87,7 +87,7 @@ TEST(FocusControl, AutoKeepsTheFirstFramesDepthAtThePoint)
 // by the critically damped spring: after 4.7 time constants 95 % of the way in dioptres, no overshoot.
 TEST(FocusControl, TrackFollowsAStepWithTheAutofocusTimeConstant)
 {
-    AutofocusSettings settings;
+    FocusTrackerOptions settings;
     settings.timeConstantS = 0.25;
     FocusControl control("track", std::nullopt, settings);
     const double dt = 1.0 / 30.0;

@@ -8,14 +8,16 @@
 // timestamp), a folder of colour images with `depth` a folder (paired by sorted name) or one file,
 // one image with one depth image, a video file with a depth folder or TUM depth list (paired by
 // index), and a V4L2 camera (/dev/videoN) with `depth` a depth image or a Z16 depth camera
-// (/dev/videoM).
-// Threads: a Source is used from one thread at a time; it makes no GL context.
+// (/dev/videoM); or a synthetic scene (SourceSettings::synthetic).
+// Threads: a Source is used from one thread at a time (any thread, one after another); only a
+// synthetic scene has a GL context, made current on the calling thread for each call, as a Filter.
 #pragma once
 
 #include <cstddef>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -32,8 +34,25 @@ public:
     using InputError::InputError;
 };
 
+/// A synthetic scene rendered frame by frame (docs/synthetic.md): the command line's --demo.
+struct SyntheticClip {
+    /// "spheres" (lights over depth edges) or "edges" (occlusion boundaries).
+    std::string scene = "spheres";
+    /// Clip length, frames, >= 1; the shot's animation spans it.
+    std::size_t frames = 60;
+    /// The camera: focal length, f-number, sensor width and blade rotation, and focusM on every
+    /// frame unless focusPull.
+    Lens lens;
+    /// The focus follows the scene's own pull, which Source::sceneFocusM gives per frame.
+    bool focusPull = true;
+};
+
+/// The scenes SyntheticClip::scene takes.
+DEFOCUS_API std::vector<std::string> syntheticScenes();
+
 struct SourceSettings {
-    /// What `defocus INPUT` takes: a folder, an image, a video file or /dev/videoN.
+    /// What `defocus INPUT` takes: a folder, an image, a video file or /dev/videoN. Not used
+    /// where `synthetic` is set.
     std::string input;
     /// --depth: a folder, an image, a TUM depth list or a Z16 camera; empty where the input names
     /// its own depth (TUM) or has none (the frames pass through in focus).
@@ -45,6 +64,10 @@ struct SourceSettings {
     int width = 640;
     int height = 480;
     double fps = 30.0;
+    /// Renders this scene instead of reading `input`: 640x480 CV_32FC3 scene-linear colour and
+    /// exact depth, 30 Hz, with OpenGL on a context of the Source's own (on `context`'s device).
+    std::optional<SyntheticClip> synthetic;
+    ContextOptions context;
 };
 
 /// One frame as the source gives it (the same type Filter::process takes apart).
@@ -70,6 +93,9 @@ public:
     double frameRate() const;
     /// A camera (frames come in real time and do not end by themselves).
     bool isLive() const;
+    /// A synthetic scene with its focus pull: the focus frame `index` was rendered for (what
+    /// Lens::focusM must be to blur it as the camera would); nullopt for any other input.
+    std::optional<double> sceneFocusM(std::size_t index) const;
     /// One line: kind, location and how colour meets depth, e.g. for the bundled clip
     /// "TUM RGB-D sequence 'data/tum_fr1_rpy' (10 frames, 10 with depth, paired by
     /// associations.txt, 30 Hz)".

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include "bench/BenchCli.hpp"
 #include "filter/Pipeline.hpp"
 #include "filter/Presets.hpp"
 #include "filter/gl/EglContext.hpp"
@@ -111,6 +112,6 @@ int main(int argc, char** argv)
         return 0;
     } catch (const std::exception& error) {
         std::fprintf(stderr, "defocus-soak: error: %s\n", error.what());
-        return cli::statusFor(error);
+        return bench::statusFor(error);
     }
 }

@@ -7,7 +7,7 @@
 //   defocus-bench-accuracy                               (run from the repository root)
 //   defocus-bench-accuracy --runs 9 -o out/accuracy --methods mcintosh,riguer
 //   defocus-bench accuracy --scene data/blender_spheres --scene data/corpus   (presets on a corpus,
-//       per scene and per zone, min and median: samples/BenchCorpus.cpp)
+//       per scene and per zone, min and median: bench/BenchCorpus.cpp)
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -30,6 +30,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/BenchCli.hpp"
+#include "bench/BenchCorpus.hpp"
 #include "bench/Metrics.hpp"
 #include "bench/methods/Method.hpp"
 #include "bench/methods/Presets.hpp"
@@ -39,7 +41,6 @@
 #include "filter/Presets.hpp"
 #include "filter/Views.hpp"
 #include "filter/gl/EglContext.hpp"
-#include "samples/BenchCorpus.hpp"
 #include "samples/BenchMachine.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
@@ -852,7 +853,7 @@ int main(int argc, char** argv)
             return runCorpusAccuracy(corpus, commandLine);
         } catch (const std::exception& error) {
             fmt::print(stderr, "defocus-bench accuracy: error: {}\n", error.what());
-            return cli::statusFor(error);
+            return bench::statusFor(error);
         }
     }
     if (sceneArgs.size() > 1) {
@@ -877,6 +878,6 @@ int main(int argc, char** argv)
         return run(options, commandLine);
     } catch (const std::exception& error) {
         fmt::print(stderr, "defocus-bench-accuracy: error: {}\n", error.what());
-        return cli::statusFor(error);
+        return bench::statusFor(error);
     }
 }

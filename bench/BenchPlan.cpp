@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Plan against always-on: the same frames through one pipeline with QualitySettings::adaptive
 // on and off, interleaved pass by pass so that the machine's drift spreads over both.
-#include "samples/BenchPlan.hpp"
+#include "bench/BenchPlan.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -14,6 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
+#include "bench/BenchCli.hpp"
 #include "filter/ColorSpace.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "samples/CliOptions.hpp"
@@ -143,6 +144,6 @@ int main(int argc, char** argv)
         return kExitDone;
     } catch (const std::exception& error) {
         spdlog::error("{}", error.what());
-        return cli::statusFor(error);
+        return bench::statusFor(error);
     }
 }

@@ -24,6 +24,9 @@
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
+#include "bench/BenchCli.hpp"
+#include "bench/BenchPlan.hpp"
+#include "bench/BenchTiming.hpp"
 #include "filter/ApiSettings.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
@@ -32,8 +35,6 @@
 #include "filter/Settings.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "samples/BenchMachine.hpp"
-#include "samples/BenchPlan.hpp"
-#include "samples/BenchTiming.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
@@ -559,7 +560,7 @@ int run(const Options& options, const std::string& commandLine)
 
 namespace {
 
-/// `defocus-bench timing`: the per-preset timing baseline and comparator (samples/BenchTiming.hpp).
+/// `defocus-bench timing`: the per-preset timing baseline and comparator (bench/BenchTiming.hpp).
 CLI::App* declareTiming(CLI::App& app, defocus::TimingOptions& o)
 {
     CLI::App* sub = app.add_subcommand("timing", "For each preset, the frame's wall time (with readback) and each "
@@ -586,7 +587,7 @@ CLI::App* declareTiming(CLI::App& app, defocus::TimingOptions& o)
     return sub;
 }
 
-/// `defocus-bench plan`: the plan against every pass on every pixel (samples/BenchPlan.hpp).
+/// `defocus-bench plan`: the plan against every pass on every pixel (bench/BenchPlan.hpp).
 CLI::App* declarePlan(CLI::App& app, defocus::PlanOptions& o)
 {
     CLI::App* sub = app.add_subcommand("plan", "ms per frame with the per-frame plan and with every pass on every "
@@ -694,6 +695,6 @@ int main(int argc, char** argv)
         return kExitUsage;
     } catch (const std::exception& error) {
         spdlog::error("{}", error.what());
-        return cli::statusFor(error);
+        return bench::statusFor(error);
     }
 }

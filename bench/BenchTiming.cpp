@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Timing baseline and comparator: medians of each preset's frame wall time and per-pass GPU time
 // over a calibration pass's, measured interleaved in one run.
-#include "samples/BenchTiming.hpp"
+#include "bench/BenchTiming.hpp"
 
 #include <algorithm>
 #include <chrono>

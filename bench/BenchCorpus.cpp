@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // defocus-bench accuracy --scene DIR: the presets measured on a corpus of scene folders.
-#include "samples/BenchCorpus.hpp"
+#include "bench/BenchCorpus.hpp"
 
 #include <algorithm>
 #include <cmath>
