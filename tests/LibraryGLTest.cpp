@@ -438,3 +438,50 @@ TEST(LibraryFocus, TrackerMeasuresWhereItIsToldAndGlides)
     EXPECT_NEAR(defocus::secondsBetweenFrames(10.0, 10.04, 1.0 / 30), 0.04, 1e-12);
     EXPECT_DOUBLE_EQ(defocus::secondsBetweenFrames(0.0, 10.04, 1.0 / 30), 1.0 / 30);
 }
+
+// Defect caught: a synthetic Source that renders nothing (no GL context of its own, or its
+// context not current where next() is called from), loses its focus pull, or takes the EGL
+// display down with it while a Filter still uses it (either may end first).
+TEST(LibrarySource, SyntheticSceneRendersInItsOwnContext)
+{
+    defocus::SourceSettings settings;
+    defocus::SyntheticClip clip;
+    clip.frames = 3;
+    settings.synthetic = clip;
+    std::optional<defocus::Source> source;
+    try {
+        source.emplace(settings);
+    } catch (const defocus::GlError& error) {
+        GTEST_SKIP() << "no OpenGL 4.5: " << error.what();
+    }
+    defocus::Filter filter;
+    ASSERT_EQ(source->frameCount(), 3u);
+    std::optional<defocus::Frame> first = source->next();
+    ASSERT_TRUE(first);
+    EXPECT_EQ(first->color.type(), CV_32FC3);
+    EXPECT_EQ(first->color.size(), cv::Size(640, 480));
+    EXPECT_EQ(first->depth.type(), CV_32FC1);
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(first->depth, &lo, &hi);
+    EXPECT_GT(hi, lo) << "a scene with depth, not a cleared target";
+    EXPECT_GT(cv::mean(first->color)[1], 0.0);
+    // The second frame from another thread, between two filtered frames on this one.
+    filter.process(first->color, first->depth);
+    std::optional<defocus::Frame> second;
+    std::thread([&] { second = source->next(); }).join();
+    ASSERT_TRUE(second);
+    EXPECT_GT(cv::mean(second->color)[1], 0.0);
+    filter.process(second->color, second->depth);
+    ASSERT_TRUE(source->sceneFocusM(0) && source->sceneFocusM(2));
+    EXPECT_NE(*source->sceneFocusM(0), *source->sceneFocusM(2)) << "the scene pulls its focus";
+    source.reset(); // the Source ends first; the Filter goes on
+    EXPECT_NO_THROW(filter.process(second->color, second->depth));
+
+    clip.focusPull = false;
+    settings.synthetic = clip;
+    defocus::Source fixed(settings);
+    EXPECT_EQ(fixed.sceneFocusM(0), std::nullopt);
+    clip.scene = "teapot";
+    settings.synthetic = clip;
+    EXPECT_THROW(defocus::Source{settings}, defocus::SettingsError);
+}
