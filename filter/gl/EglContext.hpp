@@ -99,6 +99,8 @@ public:
     /// ContextError when the context cannot be made current (it is current on another thread).
     class Scope {
     public:
+        /// Changes nothing (a Filter on its caller's context has no context of its own).
+        Scope() = default;
         explicit Scope(const EglContext& context);
         /// For a context already made current on this thread (create() does): `before` is what
         /// was current before, put back at the end.
