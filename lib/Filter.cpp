@@ -141,6 +141,15 @@ RendererInfo probeRenderer(const ContextOptions& context)
     }
 }
 
+void* eglDisplay(const ContextOptions& context)
+{
+    try {
+        return gl::EglContext::keepDisplay(toContextOptions(context));
+    } catch (const gl::ContextError& error) {
+        throw GlError(error.what());
+    }
+}
+
 std::string version()
 {
     return DEFOCUS_VERSION;

@@ -64,6 +64,9 @@ public:
     static EglContext create(const ContextOptions& options);
     /// The EGL devices of this machine (empty without EGL_EXT_device_enumeration).
     static std::vector<DeviceInfo> devices();
+    /// The EGLDisplay create(options) renders on, initialised and never terminated (another
+    /// library may hold it for the rest of the process). Throws ContextError as create() does.
+    static void* keepDisplay(const ContextOptions& options);
 
     EglContext(EglContext&&) noexcept;
     EglContext& operator=(EglContext&&) noexcept;

@@ -137,6 +137,11 @@ struct RendererInfo {
     bool timerQueries = false; ///< the driver has GPU timer queries (Timings::gpu is filled)
 };
 
+/// The EGL display (an initialised EGLDisplay) a Filter with a context of its own renders on
+/// here, kept open for the rest of the process: for a caller that must share one, such as
+/// GStreamer's GL library on a machine with no window system and no /dev/dri
+/// (gst_gl_display_egl_new_with_egl_display). Throws GlError where no context can be made.
+DEFOCUS_API void* eglDisplay(const ContextOptions& context = {});
 /// The EGL devices of this machine; empty where EGL cannot enumerate them.
 DEFOCUS_API std::vector<EglDevice> eglDevices();
 /// Makes an OpenGL 4.5 context as a Filter would (no shaders compiled), says what it is and
