@@ -430,6 +430,15 @@ bool ensureDisplay(GstDefocus* self)
     return true;
 }
 
+/// The GL path's filter destroyed on its context's thread (its GL objects are that context's).
+void dropGlFilter(State& s)
+{
+    if (s.glFilter && s.glContext)
+        gst_gl_context_thread_add(
+            s.glContext, [](GstGLContext*, gpointer state) { static_cast<State*>(state)->glFilter.reset(); }, &s);
+    s.glFilter.reset();
+}
+
 /// The display and the context the GL path renders on (under s.glLock): the neighbours' context,
 /// else one made on the display. Posts the element's error where there is none, or it is not
 /// OpenGL 4.5.
@@ -447,10 +456,12 @@ bool ensureGl(GstDefocus* self)
     if ((gst_gl_query_local_gl_context(GST_ELEMENT(self), GST_PAD_SRC, &found) ||
          gst_gl_query_local_gl_context(GST_ELEMENT(self), GST_PAD_SINK, &found)) &&
         found && found->display == s.display) {
+        dropGlFilter(s);
         gst_clear_object(&s.glContext);
         s.glContext = found;
     } else {
         gst_clear_object(&found);
+        dropGlFilter(s);
         GError* error = nullptr;
         GST_OBJECT_LOCK(s.display);
         do {
@@ -507,10 +518,7 @@ void setContext(GstElement* element, GstContext* context)
 void dropGl(State& s)
 {
     std::lock_guard guard(s.glLock);
-    if (s.glFilter && s.glContext)
-        gst_gl_context_thread_add(
-            s.glContext, [](GstGLContext*, gpointer state) { static_cast<State*>(state)->glFilter.reset(); }, &s);
-    s.glFilter.reset();
+    dropGlFilter(s);
     gst_clear_object(&s.glContext);
 }
 
