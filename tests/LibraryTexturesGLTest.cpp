@@ -23,8 +23,9 @@ namespace fs = std::filesystem;
 using Order = defocus::GlFrame::Order;
 using DepthFormat = defocus::GlFrame::DepthFormat;
 
-/// An OpenGL 4.5 core context on Mesa's surfaceless platform, made and owned here, current on
-/// this thread. Its display is never terminated (the library's Filters use it too).
+/// An OpenGL 4.5 core context made and owned here, current on this thread, on the EGL display the
+/// library renders on (defocus::eglDisplay(): an EGL device, else Mesa's surfaceless platform),
+/// which stays initialised for the rest of the process.
 struct CallerContext {
     EGLDisplay display = EGL_NO_DISPLAY;
     EGLContext context = EGL_NO_CONTEXT;
@@ -32,9 +33,10 @@ struct CallerContext {
 
     CallerContext()
     {
-        display = eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-        if (display == EGL_NO_DISPLAY || !eglInitialize(display, nullptr, nullptr)) {
-            why = "no Mesa surfaceless EGL display";
+        try {
+            display = static_cast<EGLDisplay>(defocus::eglDisplay());
+        } catch (const defocus::GlError& error) {
+            why = error.what();
             return;
         }
         const EGLint configAttributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
@@ -88,8 +90,6 @@ class LibraryTextures : public ::testing::Test {
 protected:
     static void SetUpTestSuite()
     {
-        // The Filter with a context of its own first: the library counts the users of the EGL
-        // display it shares with the test's context, and ends it with its last Filter.
         try {
             own() = std::make_unique<defocus::Filter>(settings());
         } catch (const defocus::GlError& error) {
