@@ -486,31 +486,8 @@ void Filter::processTextures(const GlFrame& frame, double timestampS)
         color = gl::readTexture(frame.color, size, bgra ? GL_RGBA : GL_BGRA, GL_UNSIGNED_BYTE, CV_8UC4);
         if (gl::textureSize(frame.output, GL_RGBA8, "output texture") != size)
             throw InputError(fmt::format("output texture {} is not the colour's size", frame.output));
-        if (frame.depth != 0) {
-            switch (frame.depthFormat) {
-            case GlFrame::DepthFormat::R16:
-                depth = gl::readTexture(frame.depth, gl::textureSize(frame.depth, GL_R16, "depth texture"), GL_RED,
-                                        GL_UNSIGNED_SHORT, CV_16UC1);
-                break;
-            case GlFrame::DepthFormat::Rg8Le: {
-                // Two bytes a texel, low first: little-endian 16-bit units, as a GRAY16_LE image.
-                cv::Mat bytes = gl::readTexture(frame.depth, gl::textureSize(frame.depth, GL_RG8, "depth texture"),
-                                                GL_RG, GL_UNSIGNED_BYTE, CV_8UC2);
-                depth.create(bytes.size(), CV_16UC1);
-                for (int y = 0; y < bytes.rows; ++y) {
-                    const auto* in = bytes.ptr<std::uint8_t>(y);
-                    auto* out = depth.ptr<std::uint16_t>(y);
-                    for (int x = 0; x < bytes.cols; ++x)
-                        out[x] = static_cast<std::uint16_t>(in[2 * x] | (in[2 * x + 1] << 8));
-                }
-                break;
-            }
-            case GlFrame::DepthFormat::R32F:
-                depth = gl::readTexture(frame.depth, gl::textureSize(frame.depth, GL_R32F, "depth texture"), GL_RED,
-                                        GL_FLOAT, CV_32FC1);
-                break;
-            }
-        }
+        if (frame.depth != 0)
+            depth = gl::readDepthTexture(frame.depth, static_cast<gl::DepthTexture>(frame.depthFormat));
     } catch (const gl::ContextError& error) {
         throw InputError(error.what());
     }

@@ -145,4 +145,25 @@ CallerState::~CallerState()
     glColorMask(colorMask_[0], colorMask_[1], colorMask_[2], colorMask_[3]);
 }
 
+cv::Mat readDepthTexture(GLuint texture, DepthTexture format)
+{
+    switch (format) {
+    case DepthTexture::R16:
+        return readTexture(texture, textureSize(texture, GL_R16, "depth texture"), GL_RED, GL_UNSIGNED_SHORT, CV_16UC1);
+    case DepthTexture::R32F:
+        return readTexture(texture, textureSize(texture, GL_R32F, "depth texture"), GL_RED, GL_FLOAT, CV_32FC1);
+    case DepthTexture::Rg8Le: break;
+    }
+    const cv::Mat bytes =
+        readTexture(texture, textureSize(texture, GL_RG8, "depth texture"), GL_RG, GL_UNSIGNED_BYTE, CV_8UC2);
+    cv::Mat units(bytes.size(), CV_16UC1);
+    for (int y = 0; y < bytes.rows; ++y) {
+        const auto* in = bytes.ptr<std::uint8_t>(y);
+        auto* out = units.ptr<std::uint16_t>(y);
+        for (int x = 0; x < bytes.cols; ++x)
+            out[x] = static_cast<std::uint16_t>(in[2 * x] | (in[2 * x + 1] << 8));
+    }
+    return units;
+}
+
 } // namespace defocus::gl

@@ -24,6 +24,12 @@ cv::Size textureSize(GLuint texture, GLenum internalFormat, const char* what);
 /// Level 0 of `texture` (size `size`) read back as `format`/`type` into an image of `cvType`.
 cv::Mat readTexture(GLuint texture, cv::Size size, GLenum format, GLenum type, int cvType);
 
+/// Depth texture formats, in the order of defocus::GlFrame::DepthFormat.
+enum class DepthTexture { R16, Rg8Le, R32F };
+/// A depth texture read back: CV_16UC1 units (GL_R16; GL_RG8 holding little-endian 16-bit, red
+/// the low byte) or CV_32FC1 metres (GL_R32F). Throws ContextError as textureSize() does.
+cv::Mat readDepthTexture(GLuint texture, DepthTexture format);
+
 /// For the life of the object, the current context's state is the passes' (FRAMEBUFFER_SRGB on;
 /// blending, depth, stencil, scissor and culling off; additive blending when a pass enables it;
 /// all colour channels written; tight pixel rows; no pixel buffers bound); then the caller's again:
