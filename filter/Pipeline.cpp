@@ -23,6 +23,7 @@
 #include "filter/passes/InFocusLightPass.hpp"
 #include "filter/passes/RhombusBlurPass.hpp"
 #include "filter/passes/NearBlurPass.hpp"
+#include "filter/passes/OutputCopyPass.hpp"
 #include "filter/passes/UpscalePass.hpp"
 #include "filter/passes/ViewPass.hpp"
 
@@ -116,6 +117,7 @@ struct Pipeline::Impl {
     NearBlurPass nearBlurPass;
     UpscalePass upscalePass;
     ViewPass viewPass;
+    OutputCopyPass outputCopyPass;
     TileList blurTiles, copyTiles, nearTiles;
     TileList detailTiles; ///< Resolution::Half: where the upscale puts the frame's detail back
     TileList highlightTiles; ///< where the CoC pass treats highlights pixel by pixel
@@ -166,6 +168,11 @@ struct Pipeline::Impl {
     std::size_t gpuFrameIndex = 0; ///< frame whose GPU scopes are pending in the timer
 
     void render();
+    /// `view` of the last frame rendered into the output target of `encoding` (not for a frame all
+    /// in focus): read() and readInto() without the read. `low`/`high`: the legend's range.
+    Target& renderOutput(View view, Encoding encoding, float& low, float& high);
+    /// The frame's read-back time from `readStart`, its total, and the GPU times it collected.
+    void finishTimings(Clock::time_point readStart);
     void renderMcIntosh(bool useTiles);
     /// Rhombi: the CoC target's two lines (pass 1). Pass 2 waits for read(): the composite
     /// runs fused into it, straight into the output; other views and readTarget() run it into
@@ -515,27 +522,9 @@ void Pipeline::Impl::render()
     rendered = true;
 }
 
-cv::Mat Pipeline::read(View view, Encoding encoding)
+Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, float& high)
 {
-    Impl& p = *impl_;
-    CV_Assert(!p.size.empty());
-    const auto start = Clock::now();
-    if (view == View::Composite && !p.rendered) {
-        // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
-        // CoC pass's clean-up (no NaN, no negatives, within the target's range).
-        const bool srgbInput = p.color.type() == CV_8UC3;
-        const cv::Mat linear = srgbInput ? cv::Mat()
-                                         : sanitizeLinear(p.color, CocPass::largestColor(
-                                                                        p.quality.targetFormat == TargetFormat::Rgba16F));
-        cv::Mat image;
-        if (encoding == Encoding::Srgb8)
-            image = srgbInput ? p.color.clone() : encodeSrgb(linear);
-        else
-            image = srgbInput ? decodeSrgb(p.color) : linear;
-        p.timings.readbackMs = msSince(start);
-        p.timings.totalMs = msSince(p.frameStart);
-        return image;
-    }
+    Impl& p = *this;
     if (!p.rendered)
         p.render();
     Target& out = encoding == Encoding::Srgb8 ? p.outSrgb : p.outLinear;
@@ -543,7 +532,6 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
                encoding == Encoding::Srgb8 ? "output sRGB" : "output linear");
 
     glBindVertexArray(p.vao.id());
-    float low = 0.0f, high = 0.0f;
     const bool fused = view == View::Composite && (p.rhombiSecondPending || p.blurShift != 0);
     if (fused) {
         // Rhombi: pass 2 with the composite in it, into the output (no A and B targets); its
@@ -591,25 +579,78 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
         p.timer.end();
     }
 
+    return out;
+}
+
+void Pipeline::Impl::finishTimings(Clock::time_point readStart)
+{
+    timings.readbackMs = msSince(readStart);
+    timings.gpu.clear();
+    for (auto& [name, ms] : timer.swap())
+        timings.gpu.push_back({name, ms});
+    timings.gpuFrame = gpuFrameIndex;
+    gpuFrameIndex = frameIndex;
+    timings.totalMs = msSince(frameStart);
+}
+
+cv::Mat Pipeline::read(View view, Encoding encoding)
+{
+    Impl& p = *impl_;
+    CV_Assert(!p.size.empty());
+    const auto start = Clock::now();
+    if (view == View::Composite && !p.rendered) {
+        // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
+        // CoC pass's clean-up (no NaN, no negatives, within the target's range).
+        const bool srgbInput = p.color.type() == CV_8UC3;
+        const cv::Mat linear = srgbInput ? cv::Mat()
+                                         : sanitizeLinear(p.color, CocPass::largestColor(
+                                                                        p.quality.targetFormat == TargetFormat::Rgba16F));
+        cv::Mat image;
+        if (encoding == Encoding::Srgb8)
+            image = srgbInput ? p.color.clone() : encodeSrgb(linear);
+        else
+            image = srgbInput ? decodeSrgb(p.color) : linear;
+        p.timings.readbackMs = msSince(start);
+        p.timings.totalMs = msSince(p.frameStart);
+        return image;
+    }
+    float low = 0.0f, high = 0.0f;
+    Target& out = p.renderOutput(view, encoding, low, high);
     cv::Mat image(p.size, encoding == Encoding::Srgb8 ? CV_8UC3 : CV_32FC3);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, out.framebuffer.id());
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, p.size.width, p.size.height, GL_BGR,
                  encoding == Encoding::Srgb8 ? GL_UNSIGNED_BYTE : GL_FLOAT, image.data);
-    p.timings.readbackMs = msSince(start);
-
-    p.timings.gpu.clear();
-    for (auto& [name, ms] : p.timer.swap())
-        p.timings.gpu.push_back({name, ms});
-    p.timings.gpuFrame = p.gpuFrameIndex;
-    p.gpuFrameIndex = p.frameIndex;
-    p.timings.totalMs = msSince(p.frameStart);
+    p.finishTimings(start);
 
     if (view == View::Depth)
         drawLegend(image, LegendKind::DepthMetres, low, high);
     else if (view == View::Coc)
         drawLegend(image, LegendKind::SignedCocPixels, -high, high);
     return image;
+}
+
+void Pipeline::readInto(View view, unsigned texture, bool bgra)
+{
+    Impl& p = *impl_;
+    CV_Assert(!p.size.empty());
+    if ((view == View::Composite && !p.rendered) || view == View::Depth || view == View::Coc) {
+        // The input as it came, or a legend drawn on the CPU: read() and uploaded. Three
+        // components into RGBA8 give alpha 1; BGR bytes read as RGB put blue in red.
+        const cv::Mat image = read(view, Encoding::Srgb8);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTextureSubImage2D(texture, 0, 0, 0, p.size.width, p.size.height, bgra ? GL_RGB : GL_BGR,
+                            GL_UNSIGNED_BYTE, image.data);
+        return;
+    }
+    const auto start = Clock::now();
+    float low = 0.0f, high = 0.0f;
+    const Target& out = p.renderOutput(view, Encoding::Srgb8, low, high);
+    const gl::Framebuffer target(texture, p.size.width, p.size.height, "caller's output");
+    p.timer.begin(OutputCopyPass::kName);
+    p.outputCopyPass.run(out.texture, out.generation, target, bgra);
+    p.timer.end();
+    p.finishTimings(start);
 }
 
 cv::Mat Pipeline::run(const Frame& frame, const LensSettings& lens, const QualitySettings& quality, View view,

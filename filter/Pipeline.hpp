@@ -64,6 +64,11 @@ public:
     /// Renders `view` of the last processed frame and reads it back. Depth and CoC views carry a
     /// legend along their bottom edge.
     cv::Mat read(View view, Encoding encoding);
+    /// read(view, Srgb8) into `texture`, a GL_RGBA8 2D texture of the frame's size (a caller's,
+    /// on this context): the same bytes, in RGBA order or with `bgra` BGRA, alpha 1. What the
+    /// passes rendered is copied on the GPU (timer scope "output-copy"); a frame all in focus and
+    /// the depth and coc views, whose legend is drawn on the CPU, are read() and uploaded.
+    void readInto(View view, unsigned texture, bool bgra);
     /// process() + read() in one call.
     cv::Mat run(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
                 View view = View::Composite, Encoding encoding = Encoding::Srgb8);

@@ -2,11 +2,17 @@
 // The GStreamer element `defocus`: colour on the `color` pad, depth on the `depth` pad, the depth
 // of field of a lens out of `src`, one frame per colour frame with its timestamp and duration,
 // each paired with the depth current at its running time (a GstVideoAggregator that runs its own
-// aggregate()). It uses only libdefocus' public API, on an EGL context of its own made on the
-// streaming thread; the library's messages go to GStreamer's log (gst/LibraryLog.hpp).
+// aggregate()). It uses only libdefocus' public API: in system memory on an EGL context of its
+// own made on the streaming thread; in GL memory (video/x-raw(memory:GLMemory)) on the pipeline's
+// GstGLContext, on its thread, with no frame mapped for the CPU, and where GStreamer's GL library
+// finds no display (a server with no window system) on the library's headless EGL display, which it
+// offers to its neighbours. The library's messages go to GStreamer's log (gst/LibraryLog.hpp).
 //   gst-launch-1.0 defocus name=d focus=1.2 f-number=1.4 ! videoconvert ! autovideosink
 //     filesrc location=clip.mp4 ! decodebin ! videoconvert ! d.color
 //     filesrc location=depth.png ! pngdec ! imagefreeze ! d.depth         (one line)
+//   gst-launch-1.0 defocus name=d ! glimagesink
+//     filesrc location=clip.mp4 ! decodebin ! glupload ! glcolorconvert ! d.color
+//     filesrc location=depth.png ! pngdec ! imagefreeze ! videoconvert ! glupload ! d.depth
 #include "gst/GstDefocus.hpp"
 #include "gst/GstDefocusSrc.hpp"
 #include "gst/LibraryLog.hpp"
@@ -19,6 +25,9 @@
 #include <string>
 
 #include <defocus/defocus.hpp>
+#include <EGL/egl.h>
+#include <gst/gl/egl/gstgldisplay_egl.h>
+#include <gst/gl/gl.h>
 #include <opencv2/imgproc.hpp>
 
 GST_DEBUG_CATEGORY_STATIC(gst_defocus_debug);
@@ -46,6 +55,15 @@ struct State {
     GstBuffer* depthFrame = nullptr;       ///< the depth frame current at the last colour frame
     GstClockTime depthEnd = GST_CLOCK_TIME_NONE; ///< its end, running time (NONE: no duration)
     GstClockTime lastDuration = GST_SECOND / 30; ///< the last colour frame's (a live deadline's step)
+
+    // GL memory (under glLock): the pipeline's display and context, shared with the neighbours.
+    std::recursive_mutex glLock;
+    GstGLDisplay* display = nullptr;
+    GstGLContext* otherContext = nullptr; ///< the application's (gst.gl.app_context), if any
+    GstGLContext* glContext = nullptr;    ///< where the GL path renders
+    std::atomic<bool> glOutput{false};    ///< the output's caps are GL memory
+    /// The filter of the GL path: made, called and destroyed on glContext's thread.
+    std::unique_ptr<defocus::Filter> glFilter;
 };
 
 } // namespace
@@ -179,13 +197,22 @@ constexpr GParamFlags kControllable = static_cast<GParamFlags>(kFlags | GST_PARA
     "{ BGRx, BGRA, RGBx, RGBA, xRGB, xBGR, ARGB, ABGR, BGR, RGB, I420, YV12, NV12, NV21, YUY2, UYVY, Y42B, Y444, " \
     "GRAY8 }"
 
+// GL memory: 8-bit RGBA textures (x: alpha ignored, written opaque), the output's memory the
+// colour's; the depth as GStreamer's GL memory holds GRAY16_LE (an RG8 texture, low byte in red).
+#define DEFOCUS_GL_CAPS(formats)                                                                                 \
+    GST_VIDEO_CAPS_MAKE_WITH_FEATURES(GST_CAPS_FEATURE_MEMORY_GL_MEMORY, formats) ", texture-target = (string) 2D"
+#define DEFOCUS_GL_RGB_FORMATS "{ RGBA, BGRA, RGBx, BGRx }"
+
 GstStaticPadTemplate srcTemplate = GST_STATIC_PAD_TEMPLATE(
-    "src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(DEFOCUS_RGB_FORMATS)));
+    "src", GST_PAD_SRC, GST_PAD_ALWAYS,
+    GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(DEFOCUS_RGB_FORMATS) "; " DEFOCUS_GL_CAPS(DEFOCUS_GL_RGB_FORMATS)));
 GstStaticPadTemplate colorTemplate = GST_STATIC_PAD_TEMPLATE(
-    "color", GST_PAD_SINK, GST_PAD_REQUEST, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(DEFOCUS_COLOR_FORMATS)));
+    "color", GST_PAD_SINK, GST_PAD_REQUEST,
+    GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(DEFOCUS_COLOR_FORMATS) "; " DEFOCUS_GL_CAPS(DEFOCUS_GL_RGB_FORMATS)));
 // 16-bit depth in depth-scale units per metre; PNG decoders give big-endian.
 GstStaticPadTemplate depthTemplate = GST_STATIC_PAD_TEMPLATE(
-    "depth", GST_PAD_SINK, GST_PAD_REQUEST, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE("{ GRAY16_LE, GRAY16_BE }")));
+    "depth", GST_PAD_SINK, GST_PAD_REQUEST,
+    GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE("{ GRAY16_LE, GRAY16_BE }") "; " DEFOCUS_GL_CAPS("GRAY16_LE")));
 
 State& stateOf(gpointer self)
 {
@@ -349,10 +376,238 @@ void pads(GstDefocus* self, GstVideoAggregatorPad*& color, GstVideoAggregatorPad
     GST_OBJECT_UNLOCK(self);
 }
 
+// ---- GL memory -----------------------------------------------------------------------------------
+//
+// In a GL pipeline the element renders on the pipeline's GstGLContext, on that context's thread,
+// with the library's Filter made for the caller's context (ContextOptions::callerContext). The
+// display and context come as GStreamer's GL elements share them: a GstContext set on the element
+// or found by a context query of the neighbours (gst_gl_ensure_element_data), the neighbours'
+// context (gst_gl_query_local_gl_context), else one made on the display.
+
+bool isGlCaps(const GstCaps* caps)
+{
+    return caps && gst_caps_get_size(caps) > 0 &&
+           gst_caps_features_contains(gst_caps_get_features(caps, 0), GST_CAPS_FEATURE_MEMORY_GL_MEMORY);
+}
+
+/// False for a display GStreamer's GL library made but cannot use: none (no window system), or an
+/// EGL default display that does not initialise (Mesa with no display and no /dev/dri).
+bool usable(GstGLDisplay* display)
+{
+    const GstGLDisplayType type = gst_gl_display_get_handle_type(display);
+    if (type == GST_GL_DISPLAY_TYPE_NONE)
+        return false;
+    if (type != GST_GL_DISPLAY_TYPE_EGL)
+        return true;
+    auto* egl = reinterpret_cast<EGLDisplay>(gst_gl_display_get_handle(display));
+    return egl != EGL_NO_DISPLAY && eglInitialize(egl, nullptr, nullptr) == EGL_TRUE;
+}
+
+/// The pipeline's GL display (under s.glLock). Where GStreamer's GL library opens none of its own
+/// that works (no window system, no EGL default display: a server with no display and no
+/// /dev/dri), one on the EGL display the library renders on, offered to the neighbours
+/// (have-context).
+bool ensureDisplay(GstDefocus* self)
+{
+    State& s = *self->state;
+    if (!gst_gl_ensure_element_data(self, &s.display, &s.otherContext))
+        return false;
+    if (!usable(s.display)) {
+        try {
+            GstGLDisplayEGL* headless = gst_gl_display_egl_new_with_egl_display(defocus::eglDisplay());
+            if (!headless)
+                return false;
+            gst_object_unref(s.display);
+            s.display = GST_GL_DISPLAY(headless);
+            GST_INFO_OBJECT(self, "no window system: GL on the library's headless EGL display");
+            gst_gl_element_propagate_display_context(GST_ELEMENT(self), s.display);
+        } catch (const defocus::GlError& error) {
+            GST_WARNING_OBJECT(self, "no headless EGL display either: %s", error.what());
+            return false;
+        }
+    }
+    gst_gl_display_filter_gl_api(s.display, GST_GL_API_OPENGL3);
+    return true;
+}
+
+/// The GL path's filter destroyed on its context's thread (its GL objects are that context's).
+void dropGlFilter(State& s)
+{
+    if (s.glFilter && s.glContext)
+        gst_gl_context_thread_add(
+            s.glContext, [](GstGLContext*, gpointer state) { static_cast<State*>(state)->glFilter.reset(); }, &s);
+    s.glFilter.reset();
+}
+
+/// The display and the context the GL path renders on (under s.glLock): the neighbours' context,
+/// else one made on the display. Posts the element's error where there is none, or it is not
+/// OpenGL 4.5.
+bool ensureGl(GstDefocus* self)
+{
+    State& s = *self->state;
+    std::lock_guard guard(s.glLock);
+    if (!ensureDisplay(self)) {
+        GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("No OpenGL display for GL memory"), (nullptr));
+        return false;
+    }
+    if (s.glContext && s.glContext->display == s.display)
+        return true;
+    GstGLContext* found = nullptr;
+    if ((gst_gl_query_local_gl_context(GST_ELEMENT(self), GST_PAD_SRC, &found) ||
+         gst_gl_query_local_gl_context(GST_ELEMENT(self), GST_PAD_SINK, &found)) &&
+        found && found->display == s.display) {
+        dropGlFilter(s);
+        gst_clear_object(&s.glContext);
+        s.glContext = found;
+    } else {
+        gst_clear_object(&found);
+        dropGlFilter(s);
+        GError* error = nullptr;
+        GST_OBJECT_LOCK(s.display);
+        do {
+            gst_clear_object(&s.glContext);
+            s.glContext = gst_gl_display_get_gl_context_for_thread(s.display, nullptr);
+            if (!s.glContext && !gst_gl_display_create_context(s.display, s.otherContext, &s.glContext, &error))
+                break;
+        } while (!gst_gl_display_add_context(s.display, s.glContext));
+        GST_OBJECT_UNLOCK(s.display);
+        if (!s.glContext) {
+            GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("No OpenGL context for GL memory"), ("%s",
+                              error ? error->message : "unknown"));
+            g_clear_error(&error);
+            return false;
+        }
+    }
+    if (!gst_gl_context_check_gl_version(s.glContext, GST_GL_API_OPENGL3, 4, 5)) {
+        gint major = 0, minor = 0;
+        gst_gl_context_get_gl_version(s.glContext, &major, &minor);
+        GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("No OpenGL 4.5 for the defocus filter"),
+                          ("the pipeline's GL context is OpenGL %d.%d (core profile 4.5 needed)", major, minor));
+        gst_clear_object(&s.glContext);
+        return false;
+    }
+    return true;
+}
+
+/// Context queries of the neighbours: the display (made here where none was: the headless one),
+/// the context and the application's context.
+bool contextQuery(GstDefocus* self, GstQuery* query)
+{
+    State& s = *self->state;
+    std::lock_guard guard(s.glLock);
+    const gchar* type = nullptr;
+    gst_query_parse_context_type(query, &type);
+    if (g_strcmp0(type, GST_GL_DISPLAY_CONTEXT_TYPE) == 0 && !s.display)
+        ensureDisplay(self);
+    return gst_gl_handle_context_query(GST_ELEMENT(self), query, s.display, s.glContext, s.otherContext);
+}
+
+void setContext(GstElement* element, GstContext* context)
+{
+    State& s = stateOf(element);
+    {
+        std::lock_guard guard(s.glLock);
+        gst_gl_handle_set_context(element, context, &s.display, &s.otherContext);
+        if (s.display)
+            gst_gl_display_filter_gl_api(s.display, GST_GL_API_OPENGL3);
+    }
+    GST_ELEMENT_CLASS(gst_defocus_parent_class)->set_context(element, context);
+}
+
+/// The GL path's filter destroyed on its context's thread, and the context let go.
+void dropGl(State& s)
+{
+    std::lock_guard guard(s.glLock);
+    dropGlFilter(s);
+    gst_clear_object(&s.glContext);
+}
+
+/// Upstream's buffers in GL memory: a GL buffer pool on the context, and sync metas.
+gboolean proposeAllocation(GstAggregator* agg, GstAggregatorPad* pad, GstQuery* decideQuery, GstQuery* query)
+{
+    GstCaps* caps = nullptr;
+    gboolean needPool = FALSE;
+    gst_query_parse_allocation(query, &caps, &needPool);
+    if (!isGlCaps(caps))
+        return GST_AGGREGATOR_CLASS(gst_defocus_parent_class)->propose_allocation(agg, pad, decideQuery, query);
+    auto* self = GST_DEFOCUS(agg);
+    State& s = *self->state;
+    GstVideoInfo info;
+    if (!gst_video_info_from_caps(&info, caps) || !ensureGl(self))
+        return FALSE;
+    std::lock_guard guard(s.glLock);
+    if (needPool) {
+        GstBufferPool* pool = gst_gl_buffer_pool_new(s.glContext);
+        GstStructure* config = gst_buffer_pool_get_config(pool);
+        gst_buffer_pool_config_set_params(config, caps, static_cast<guint>(info.size), 0, 0);
+        gst_buffer_pool_config_add_option(config, GST_BUFFER_POOL_OPTION_GL_SYNC_META);
+        if (!gst_buffer_pool_set_config(pool, config)) {
+            gst_object_unref(pool);
+            return FALSE;
+        }
+        gst_query_add_allocation_pool(query, pool, static_cast<guint>(info.size), 1, 0);
+        gst_object_unref(pool);
+    }
+    gst_query_add_allocation_meta(query, GST_GL_SYNC_META_API_TYPE, nullptr);
+    return TRUE;
+}
+
+/// Output in GL memory: a GL buffer pool on the context (downstream's, where it offers a GL one of
+/// this context; a GL memory allocator it offers is used), its buffers with sync metas.
+gboolean decideAllocation(GstAggregator* agg, GstQuery* query)
+{
+    GstCaps* caps = nullptr;
+    gst_query_parse_allocation(query, &caps, nullptr);
+    if (!isGlCaps(caps))
+        return GST_AGGREGATOR_CLASS(gst_defocus_parent_class)->decide_allocation(agg, query);
+    auto* self = GST_DEFOCUS(agg);
+    State& s = *self->state;
+    GstVideoInfo info;
+    if (!gst_video_info_from_caps(&info, caps) || !ensureGl(self))
+        return FALSE;
+    std::lock_guard guard(s.glLock);
+    GstBufferPool* pool = nullptr;
+    guint size = static_cast<guint>(info.size), min = 0, max = 0;
+    const bool fromQuery = gst_query_get_n_allocation_pools(query) > 0;
+    if (fromQuery) {
+        gst_query_parse_nth_allocation_pool(query, 0, &pool, &size, &min, &max);
+        if (pool && (!GST_IS_GL_BUFFER_POOL(pool) || GST_GL_BUFFER_POOL(pool)->context != s.glContext))
+            gst_clear_object(&pool);
+        size = std::max(size, static_cast<guint>(info.size));
+    }
+    if (!pool)
+        pool = gst_gl_buffer_pool_new(s.glContext);
+    GstStructure* config = gst_buffer_pool_get_config(pool);
+    gst_buffer_pool_config_set_params(config, caps, size, min, max);
+    gst_buffer_pool_config_add_option(config, GST_BUFFER_POOL_OPTION_VIDEO_META);
+    gst_buffer_pool_config_add_option(config, GST_BUFFER_POOL_OPTION_GL_SYNC_META);
+    if (gst_query_get_n_allocation_params(query) > 0) {
+        GstAllocator* allocator = nullptr;
+        GstAllocationParams params;
+        gst_query_parse_nth_allocation_param(query, 0, &allocator, &params);
+        if (allocator && GST_IS_GL_MEMORY_ALLOCATOR(allocator))
+            gst_buffer_pool_config_set_allocator(config, allocator, &params);
+        gst_clear_object(&allocator);
+    }
+    if (!gst_buffer_pool_set_config(pool, config)) {
+        GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("The GL buffer pool refused its configuration"), (nullptr));
+        gst_object_unref(pool);
+        return FALSE;
+    }
+    if (fromQuery)
+        gst_query_set_nth_allocation_pool(query, 0, pool, size, min, max);
+    else
+        gst_query_add_allocation_pool(query, pool, size, min, max);
+    gst_object_unref(pool);
+    return TRUE;
+}
+
 // The base class offers a pad the output's caps; depth has caps of its own (GRAY16), whatever the
 // output is.
 gboolean sinkQuery(GstAggregator* agg, GstAggregatorPad* pad, GstQuery* query)
 {
+    if (GST_QUERY_TYPE(query) == GST_QUERY_CONTEXT && contextQuery(GST_DEFOCUS(agg), query))
+        return TRUE;
     GST_OBJECT_LOCK(agg);
     const bool depth = GST_VIDEO_AGGREGATOR_PAD(pad) == stateOf(agg).depth;
     GST_OBJECT_UNLOCK(agg);
@@ -380,6 +635,13 @@ gboolean sinkQuery(GstAggregator* agg, GstAggregatorPad* pad, GstQuery* query)
     return GST_AGGREGATOR_CLASS(gst_defocus_parent_class)->sink_query(agg, pad, query);
 }
 
+gboolean srcQuery(GstAggregator* agg, GstQuery* query)
+{
+    if (GST_QUERY_TYPE(query) == GST_QUERY_CONTEXT && contextQuery(GST_DEFOCUS(agg), query))
+        return TRUE;
+    return GST_AGGREGATOR_CLASS(gst_defocus_parent_class)->src_query(agg, query);
+}
+
 // ---- caps ----------------------------------------------------------------------------------------
 
 /// The output has the colour's size, frame rate (0/1, variable, where the colour's is) and pixel
@@ -397,6 +659,9 @@ GstFlowReturn updateSrcCaps(GstAggregator* agg, GstCaps* downstream, GstCaps** r
     GST_OBJECT_LOCK(self);
     const GstVideoInfo info = color->info;
     GST_OBJECT_UNLOCK(self);
+    GstCaps* colorCaps = gst_pad_get_current_caps(GST_PAD(color));
+    const bool gl = isGlCaps(colorCaps);
+    gst_clear_caps(&colorCaps);
     gst_object_unref(color);
     if (!info.finfo || GST_VIDEO_INFO_FORMAT(&info) == GST_VIDEO_FORMAT_UNKNOWN)
         return GST_AGGREGATOR_FLOW_NEED_DATA;
@@ -404,6 +669,9 @@ GstFlowReturn updateSrcCaps(GstAggregator* agg, GstCaps* downstream, GstCaps** r
     GstCaps* shape = gst_caps_new_simple("video/x-raw", "width", G_TYPE_INT, info.width, "height", G_TYPE_INT,
                                          info.height, "pixel-aspect-ratio", GST_TYPE_FRACTION, info.par_n,
                                          info.par_d, nullptr);
+    // The output's memory is the colour's: GL memory stays on the GPU, system memory in RAM.
+    if (gl)
+        gst_caps_set_features(shape, 0, gst_caps_features_new(GST_CAPS_FEATURE_MEMORY_GL_MEMORY, nullptr));
     // The colour's rate; 0/1 (variable: each frame has its own duration, a still image) stays so.
     gst_caps_set_simple(shape, "framerate", GST_TYPE_FRACTION, info.fps_n, info.fps_n > 0 ? info.fps_d : 1, nullptr);
     GstCaps* possible = gst_caps_intersect(downstream, shape);
@@ -431,6 +699,7 @@ gboolean negotiatedSrcCaps(GstAggregator* agg, GstCaps* caps)
     GST_OBJECT_LOCK(agg);
     GST_VIDEO_AGGREGATOR(agg)->info = info;
     GST_OBJECT_UNLOCK(agg);
+    self->state->glOutput = isGlCaps(caps);
     GstVideoAggregatorPad *color = nullptr, *depth = nullptr;
     pads(self, color, depth);
     if (color) {
@@ -621,23 +890,39 @@ GstClockTime durationOf(GstVideoAggregator* vagg, GstBuffer* color)
     return GST_CLOCK_TIME_NONE;
 }
 
-/// Filters `color` (the output's format) with `depth` into `outbuf`, whose PTS is set.
-GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, GstVideoFrame* depth)
-{
-    State& s = *self->state;
-    GstAggregator* agg = GST_AGGREGATOR(self);
+/// What a frame is filtered with: the properties at its stream time (keyframed ones through
+/// GstController) and its running time in seconds (the autofocus' clock).
+struct FrameSetup {
+    defocus::Settings settings;
+    bool changed = false; ///< since the last frame
+    bool post = false;    ///< post-timings
+    double seconds = 0.0;
+};
 
-    // Keyframed properties (GstController) at this frame's stream time.
-    const GstClockTime pts = GST_BUFFER_PTS(outbuf);
+FrameSetup setUpFrame(GstDefocus* self, GstClockTime pts)
+{
+    GstAggregator* agg = GST_AGGREGATOR(self);
     GST_OBJECT_LOCK(agg->srcpad);
     const GstSegment segment = GST_AGGREGATOR_PAD(agg->srcpad)->segment;
     GST_OBJECT_UNLOCK(agg->srcpad);
     const GstClockTime streamTime = gst_segment_to_stream_time(&segment, GST_FORMAT_TIME, pts);
     if (GST_CLOCK_TIME_IS_VALID(streamTime))
         gst_object_sync_values(GST_OBJECT(self), streamTime);
+    FrameSetup setup;
+    setup.settings = currentSettings(self, setup.changed, setup.post);
+    const GstClockTime running = gst_segment_to_running_time(&segment, GST_FORMAT_TIME, pts);
+    setup.seconds = GST_CLOCK_TIME_IS_VALID(running) ? static_cast<double>(running) / GST_SECOND : 0.0;
+    return setup;
+}
 
-    bool changed = false, post = false;
-    const defocus::Settings settings = currentSettings(self, changed, post);
+/// Filters `color` (the output's format) with `depth` into `outbuf`, whose PTS is set.
+GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, GstVideoFrame* depth)
+{
+    State& s = *self->state;
+    const GstClockTime pts = GST_BUFFER_PTS(outbuf);
+    const FrameSetup setup = setUpFrame(self, pts);
+    const defocus::Settings& settings = setup.settings;
+    const bool changed = setup.changed, post = setup.post;
     const defocus::gst::LibraryCall call(GST_ELEMENT(self));
 
     try {
@@ -667,9 +952,7 @@ GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, 
         ret = GST_FLOW_ERROR;
     } else {
         try {
-            const GstClockTime running = gst_segment_to_running_time(&segment, GST_FORMAT_TIME, pts);
-            const double seconds = GST_CLOCK_TIME_IS_VALID(running) ? static_cast<double>(running) / GST_SECOND : 0.0;
-            const cv::Mat result = s.filter->process(toFilter(color), depthOf(depth), seconds);
+            const cv::Mat result = s.filter->process(toFilter(color), depthOf(depth), setup.seconds);
             fromFilter(result, &out);
             if (post)
                 postTimings(self, s.filter->lastFrame(), pts);
@@ -684,6 +967,129 @@ GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, 
     }
     // The streaming thread may be another one after a seek or a pause: let it take the context.
     s.filter->release();
+    return ret;
+}
+
+/// One frame of the GL path, run on the GL context's thread (gst_gl_context_thread_add).
+struct GlJob {
+    GstDefocus* self = nullptr;
+    const FrameSetup* setup = nullptr;
+    defocus::GlFrame frame;
+    bool noGl = false;       ///< the filter could not be made on the context
+    std::string error;       ///< empty: done
+    defocus::FrameReport report;
+};
+
+void runGlJob(GstGLContext*, gpointer data)
+{
+    GlJob& job = *static_cast<GlJob*>(data);
+    State& s = *job.self->state;
+    const defocus::gst::LibraryCall call(GST_ELEMENT(job.self));
+    try {
+        if (!s.glFilter) {
+            defocus::ContextOptions options;
+            options.callerContext = true;
+            try {
+                s.glFilter = std::make_unique<defocus::Filter>(job.setup->settings, options);
+            } catch (const defocus::GlError&) {
+                job.noGl = true;
+                throw;
+            }
+            GST_INFO_OBJECT(job.self, "filtering GL memory on %s", s.glFilter->renderer().c_str());
+        } else if (job.setup->changed) {
+            s.glFilter->setSettings(job.setup->settings);
+        }
+        if (s.resetPending.exchange(false))
+            s.glFilter->reset();
+        s.glFilter->processTextures(job.frame, job.setup->seconds);
+        job.report = s.glFilter->lastFrame();
+    } catch (const defocus::Error& error) {
+        job.error = error.what();
+    } catch (const cv::Exception& error) {
+        job.error = error.what();
+    }
+}
+
+/// `access` for GL (GST_MAP_GL: the texture, no CPU copy).
+GstMapFlags forGl(GstMapFlags access)
+{
+    const guint flags = static_cast<guint>(access) | static_cast<guint>(GST_MAP_GL);
+    return static_cast<GstMapFlags>(flags);
+}
+
+/// The texture of a frame mapped for GL (GST_MAP_GL: no CPU copy).
+guint textureOf(GstVideoFrame* frame)
+{
+    return *static_cast<guint*>(GST_VIDEO_FRAME_PLANE_DATA(frame, 0));
+}
+
+/// GL memory in and out: `color` and `depth` (their pads' infos) filtered into `outbuf`'s texture
+/// on the context's thread, after upstream's sync points, with a sync point of its own.
+GstFlowReturn renderGl(GstDefocus* self, GstBuffer* outbuf, GstBuffer* color, GstVideoInfo* colorInfo,
+                       GstBuffer* depth, GstVideoInfo* depthInfo)
+{
+    State& s = *self->state;
+    std::lock_guard guard(s.glLock);
+    if (!s.glContext && !ensureGl(self))
+        return GST_FLOW_ERROR;
+    for (GstBuffer* buffer : {color, depth})
+        if (gst_buffer_n_memory(buffer) == 0 || !gst_is_gl_memory(gst_buffer_peek_memory(buffer, 0))) {
+            GST_ELEMENT_ERROR(self, STREAM, FORMAT, ("GL memory out needs the colour and the depth in GL memory"),
+                              ("put glupload before the %s pad", buffer == color ? "color" : "depth"));
+            return GST_FLOW_ERROR;
+        }
+    const FrameSetup setup = setUpFrame(self, GST_BUFFER_PTS(outbuf));
+    for (GstBuffer* buffer : {color, depth})
+        if (GstGLSyncMeta* sync = gst_buffer_get_gl_sync_meta(buffer))
+            gst_gl_sync_meta_wait(sync, s.glContext);
+
+    GstVideoFrame in{}, far{}, out{};
+    const GstMapFlags glRead = forGl(GST_MAP_READ), glWrite = forGl(GST_MAP_WRITE);
+    const bool mapped = gst_video_frame_map(&in, colorInfo, color, glRead);
+    const bool depthMapped = gst_video_frame_map(&far, depthInfo, depth, glRead);
+    const bool outMapped = gst_video_frame_map(&out, &GST_VIDEO_AGGREGATOR(self)->info, outbuf, glWrite);
+    GstFlowReturn ret = GST_FLOW_OK;
+    if (!mapped || !depthMapped || !outMapped) {
+        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("A GL frame could not be mapped for GL"), (nullptr));
+        ret = GST_FLOW_ERROR;
+    } else {
+        const auto order = [](GstVideoFormat format) {
+            return format == GST_VIDEO_FORMAT_BGRA || format == GST_VIDEO_FORMAT_BGRx ? defocus::GlFrame::Order::Bgra
+                                                                                      : defocus::GlFrame::Order::Rgba;
+        };
+        GlJob job;
+        job.self = self;
+        job.setup = &setup;
+        job.frame.color = textureOf(&in);
+        job.frame.colorOrder = order(GST_VIDEO_FRAME_FORMAT(&in));
+        job.frame.depth = textureOf(&far);
+        job.frame.depthFormat = defocus::GlFrame::DepthFormat::Rg8Le;
+        job.frame.output = textureOf(&out);
+        job.frame.outputOrder = order(GST_VIDEO_FRAME_FORMAT(&out));
+        job.frame.width = GST_VIDEO_FRAME_WIDTH(&in);
+        job.frame.height = GST_VIDEO_FRAME_HEIGHT(&in);
+        gst_gl_context_thread_add(s.glContext, runGlJob, &job);
+        if (job.noGl) {
+            GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("No OpenGL 4.5 for the defocus filter"), ("%s", job.error.c_str()));
+            ret = GST_FLOW_ERROR;
+        } else if (!job.error.empty()) {
+            GST_ELEMENT_ERROR(self, STREAM, FORMAT, ("%s", job.error.c_str()), (nullptr));
+            ret = GST_FLOW_ERROR;
+        } else {
+            GstGLSyncMeta* sync = gst_buffer_get_gl_sync_meta(outbuf);
+            if (!sync)
+                sync = gst_buffer_add_gl_sync_meta(s.glContext, outbuf);
+            gst_gl_sync_meta_set_sync_point(sync, s.glContext);
+            if (setup.post)
+                postTimings(self, job.report, GST_BUFFER_PTS(outbuf));
+        }
+    }
+    if (outMapped)
+        gst_video_frame_unmap(&out);
+    if (depthMapped)
+        gst_video_frame_unmap(&far);
+    if (mapped)
+        gst_video_frame_unmap(&in);
     return ret;
 }
 
@@ -806,7 +1212,11 @@ GstFlowReturn aggregate(GstAggregator* agg, gboolean timeout)
         GstVideoFrame prepared{}, depthFrame{};
         GST_OBJECT_LOCK(self);
         GstVideoInfo depthInfo = depthPad->info;
+        GstVideoInfo colorInfo = colorPad->info;
         GST_OBJECT_UNLOCK(self);
+        if (s.glOutput) {
+            ret = renderGl(self, outbuf, colorBuffer, &colorInfo, s.depthFrame, &depthInfo);
+        } else {
         const bool colorMapped = colorClass->prepare_frame(colorPad, vagg, colorBuffer, &prepared) && prepared.buffer;
         const bool depthMapped = gst_video_frame_map(&depthFrame, &depthInfo, s.depthFrame, GST_MAP_READ);
         if (!colorMapped || !depthMapped) {
@@ -818,6 +1228,7 @@ GstFlowReturn aggregate(GstAggregator* agg, gboolean timeout)
         if (depthMapped)
             gst_video_frame_unmap(&depthFrame);
         colorClass->clean_frame(colorPad, vagg, &prepared);
+        }
     }
     gst_buffer_unref(colorBuffer);
     unrefPads();
@@ -847,6 +1258,7 @@ gboolean stop(GstAggregator* agg)
     State& s = stateOf(agg);
     // The streaming task has stopped and released the context: it can be made current here.
     s.filter.reset();
+    dropGl(s);
     s.warned.clear();
     s.resetPending = false;
     s.depthStale = false;
@@ -860,8 +1272,12 @@ gboolean stop(GstAggregator* agg)
 
 void finalize(GObject* object)
 {
-    gst_clear_buffer(&GST_DEFOCUS(object)->state->depthFrame);
-    delete GST_DEFOCUS(object)->state;
+    State& s = *GST_DEFOCUS(object)->state;
+    gst_clear_buffer(&s.depthFrame);
+    dropGl(s);
+    gst_clear_object(&s.otherContext);
+    gst_clear_object(&s.display);
+    delete &s;
     G_OBJECT_CLASS(gst_defocus_parent_class)->finalize(object);
 }
 
@@ -974,9 +1390,13 @@ static void gst_defocus_class_init(GstDefocusClass* klass)
     gst_element_class_add_static_pad_template_with_gtype(element, &colorTemplate, GST_TYPE_VIDEO_AGGREGATOR_CONVERT_PAD);
     gst_element_class_add_static_pad_template_with_gtype(element, &depthTemplate, GST_TYPE_VIDEO_AGGREGATOR_PAD);
     element->release_pad = releasePad;
+    element->set_context = setContext;
 
     agg->create_new_pad = createNewPad;
     agg->sink_query = sinkQuery;
+    agg->src_query = srcQuery;
+    agg->propose_allocation = proposeAllocation;
+    agg->decide_allocation = decideAllocation;
     agg->sink_event = sinkEvent;
     agg->negotiated_src_caps = negotiatedSrcCaps;
     agg->update_src_caps = updateSrcCaps;

@@ -20,6 +20,7 @@
 #include "filter/SceneAnalysis.hpp"
 #include "filter/Settings.hpp"
 #include "filter/Views.hpp"
+#include "filter/gl/CallerContext.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
 
@@ -161,13 +162,24 @@ std::optional<Quality::Preset> qualityNamed(std::string_view name)
     return parsePreset(name);
 }
 
+void* eglDisplay(const ContextOptions& context)
+{
+    try {
+        return gl::EglContext::keepDisplay(toContextOptions(context));
+    } catch (const gl::ContextError& error) {
+        throw GlError(error.what());
+    }
+}
+
 std::string version()
 {
     return DEFOCUS_VERSION;
 }
 
 struct Filter::Impl {
-    gl::EglContext context;
+    std::optional<gl::EglContext> context; ///< none: the caller's (ContextOptions::callerContext)
+    RendererInfo callerInfo;               ///< the caller's context, where it renders on that
+    const GlFrame* textureFrame = nullptr; ///< processTextures()' frame, during that call
     std::optional<Pipeline> pipeline; ///< destroyed first, with the context current
     Settings settings;
     LensSettings lens;
@@ -182,17 +194,24 @@ struct Filter::Impl {
     std::optional<Frame> lastFrame;
     LensSettings lastLens;
 
-    explicit Impl(gl::EglContext made) : context(std::move(made)) {}
+    explicit Impl(std::optional<gl::EglContext> made) : context(std::move(made)) {}
 
     /// report from the pipeline's last frame, frame number `index`.
     void fillReport(std::size_t index);
 
     /// The context current on the calling thread until the end of the call, whichever thread
-    /// used the Filter before; then what was current there before is again.
-    gl::EglContext::Scope current() const
+    /// used the Filter before; then what was current there before is again. On the caller's
+    /// context: its GL state is the passes' until the end of the call, then the caller's again.
+    struct Call {
+        gl::EglContext::Scope scope;
+        std::optional<gl::CallerState> callerState;
+    };
+    Call current() const
     {
+        if (!context)
+            return {{}, std::optional<gl::CallerState>(std::in_place)};
         try {
-            return gl::EglContext::Scope(context);
+            return {gl::EglContext::Scope(*context), std::nullopt};
         } catch (const gl::ContextError& error) {
             throw GlError(fmt::format("defocus::Filter: {} (a Filter is not thread-safe: one call at a time)",
                                       error.what()));
@@ -244,10 +263,18 @@ Filter::Filter(const Settings& settings, const ContextOptions& context)
     if (const auto issues = check(checked); !issues.empty())
         throw SettingsError(issues.front());
     try {
+        if (context.callerContext) {
+            impl_ = std::make_unique<Impl>(std::nullopt);
+            impl_->callerInfo = toRendererInfo(gl::callerContextInfo());
+            const auto bound = impl_->current();
+            impl_->pipeline.emplace();
+            impl_->apply(settings);
+            return;
+        }
         // create() makes the context current here: what was current before is put back.
         const gl::EglContext::Binding before = gl::EglContext::Binding::current();
         impl_ = std::make_unique<Impl>(gl::EglContext::create(toContextOptions(context)));
-        const gl::EglContext::Scope bound(impl_->context, before);
+        const gl::EglContext::Scope bound(*impl_->context, before);
         impl_->pipeline.emplace();
     } catch (const gl::ContextError& error) {
         throw GlError(error.what());
@@ -349,7 +376,14 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     const auto bound = p.current();
     const Encoding encoding =
         p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
-    cv::Mat out = p.pipeline->run(frame, lens, p.quality, toView(p.settings.view), encoding);
+    cv::Mat out;
+    if (p.textureFrame) { // processTextures(): the result stays on the GPU
+        p.pipeline->process(frame, lens, p.quality);
+        p.pipeline->readInto(toView(p.settings.view), p.textureFrame->output,
+                             p.textureFrame->outputOrder == GlFrame::Order::Bgra);
+    } else {
+        out = p.pipeline->run(frame, lens, p.quality, toView(p.settings.view), encoding);
+    }
     p.lastFrame = std::move(frame);
     p.lastLens = lens;
     p.fillReport(p.frames++);
@@ -447,18 +481,51 @@ void Filter::release()
 {
     // Every call puts back what was current on its thread before it, so the context is not
     // left bound anywhere; this unbinds it only where it still is (it never should be).
-    if (impl_->context.isCurrent())
-        impl_->context.release();
+    if (impl_->context && impl_->context->isCurrent())
+        impl_->context->release();
 }
 
 std::string Filter::renderer() const
 {
-    return impl_->context.info().glRenderer;
+    return rendererInfo().glRenderer;
 }
 
 RendererInfo Filter::rendererInfo() const
 {
-    return toRendererInfo(impl_->context.info());
+    return impl_->context ? toRendererInfo(impl_->context->info()) : impl_->callerInfo;
+}
+
+void Filter::processTextures(const GlFrame& frame, double timestampS)
+{
+    Impl& p = *impl_;
+    if (p.context)
+        throw InputError("processTextures: this Filter renders on a context of its own; make it with "
+                         "ContextOptions::callerContext on the context that holds the textures");
+    const auto bound = p.current();
+    cv::Mat color, depth;
+    try {
+        const bool bgra = frame.colorOrder == GlFrame::Order::Bgra;
+        const cv::Size size = gl::textureSize(frame.color, GL_RGBA8, "colour texture");
+        if (size != cv::Size(frame.width, frame.height))
+            throw InputError(fmt::format("colour texture {} is {}x{}, not the frame's {}x{}", frame.color, size.width,
+                                         size.height, frame.width, frame.height));
+        // BGRA bytes either way: the red channel is red (read as BGRA) or holds blue (as RGBA).
+        color = gl::readTexture(frame.color, size, bgra ? GL_RGBA : GL_BGRA, GL_UNSIGNED_BYTE, CV_8UC4);
+        if (gl::textureSize(frame.output, GL_RGBA8, "output texture") != size)
+            throw InputError(fmt::format("output texture {} is not the colour's size", frame.output));
+        if (frame.depth != 0)
+            depth = gl::readDepthTexture(frame.depth, static_cast<gl::DepthTexture>(frame.depthFormat));
+    } catch (const gl::ContextError& error) {
+        throw InputError(error.what());
+    }
+    p.textureFrame = &frame;
+    try {
+        process(color, depth, timestampS);
+    } catch (...) {
+        p.textureFrame = nullptr;
+        throw;
+    }
+    p.textureFrame = nullptr;
 }
 
 } // namespace defocus

@@ -37,6 +37,7 @@ packages=(
 if [ "$tier" != build ]; then
   packages+=(
     gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good   # the element's tests: gst-launch-1.0, pngdec, imagefreeze
+    gstreamer1.0-gl xvfb   # the element's GL memory tests: glupload, gldownload; an X display for GLX
     parallel               # the batch test: defocus --batch under GNU parallel
   )
 fi

@@ -350,6 +350,13 @@ void EglContext::release() const
     eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
 }
 
+void* EglContext::keepDisplay(const ContextOptions& options)
+{
+    const EglContext context = create(options);
+    retainDisplay(context.state_->display); // one user more than any context: never terminated
+    return context.state_->display;
+}
+
 EglContext::Binding EglContext::Binding::current()
 {
     return {eglGetCurrentDisplay(), eglGetCurrentSurface(EGL_DRAW), eglGetCurrentSurface(EGL_READ),

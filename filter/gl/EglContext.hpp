@@ -64,6 +64,9 @@ public:
     static EglContext create(const ContextOptions& options);
     /// The EGL devices of this machine (empty without EGL_EXT_device_enumeration).
     static std::vector<DeviceInfo> devices();
+    /// The EGLDisplay create(options) renders on, initialised and never terminated (another
+    /// library may hold it for the rest of the process). Throws ContextError as create() does.
+    static void* keepDisplay(const ContextOptions& options);
 
     EglContext(EglContext&&) noexcept;
     EglContext& operator=(EglContext&&) noexcept;
@@ -99,6 +102,8 @@ public:
     /// ContextError when the context cannot be made current (it is current on another thread).
     class Scope {
     public:
+        /// Changes nothing (a Filter on its caller's context has no context of its own).
+        Scope() = default;
         explicit Scope(const EglContext& context);
         /// For a context already made current on this thread (create() does): `before` is what
         /// was current before, put back at the end.

@@ -61,6 +61,16 @@ Framebuffer::Framebuffer(const Texture& first, const Texture& second, std::strin
     label(GL_FRAMEBUFFER, id, name);
 }
 
+Framebuffer::Framebuffer(GLuint texture, int width, int height, std::string_view name)
+    : width_(width), height_(height)
+{
+    GLuint id = 0;
+    glCreateFramebuffers(1, &id);
+    handle_ = Handle<deleteFramebuffer>(id);
+    glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, texture, 0);
+    label(GL_FRAMEBUFFER, id, name);
+}
+
 void Framebuffer::bindForDraw() const
 {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, id());

@@ -93,6 +93,8 @@ public:
     /// Attaches `first` and `second` as draw buffers 0 and 1 (outputs at locations 0 and 1);
     /// both of the same size, not owned.
     Framebuffer(const Texture& first, const Texture& second, std::string_view name);
+    /// Attaches the 2D texture `texture` of `width` x `height` that a caller owns (not a Texture).
+    Framebuffer(GLuint texture, int width, int height, std::string_view name);
 
     GLuint id() const { return handle_.id(); }
     explicit operator bool() const { return bool(handle_); }

@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The `defocus` element through GstHarness: colour and depth pushed, the result pulled and held
 // equal, byte for byte, to libdefocus on the same frame; passthrough, property changes,
-// keyframed focus, EOS on either pad, flushing, caps it refuses, the errors it posts, and one
-// frame out per colour frame with its timestamp (a clip with gaps through defocussrc too).
+// keyframed focus, EOS on either pad, flushing, caps it refuses, the errors it posts, one frame
+// out per colour frame with its timestamp (a clip with gaps through defocussrc too), and GL memory
+// in and out with no frame mapped for the CPU.
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <thread>
 #include <unistd.h>
+#include <cstring>
 #include <utility>
 #include <fstream>
 #include <sstream>
@@ -18,6 +21,8 @@
 #include <gst/check/gstharness.h>
 #include <gst/controller/gstinterpolationcontrolsource.h>
 #include <gst/controller/gstdirectcontrolbinding.h>
+#include <gst/gl/egl/gstgldisplay_egl.h>
+#include <gst/gl/gl.h>
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -664,6 +669,188 @@ TEST_F(GstDefocus, LiveSourcesFlowAndLatencyIsReported)
     gst_element_set_state(pipeline, GST_STATE_NULL);
     gst_object_unref(bus);
     gst_object_unref(pipeline);
+}
+
+// ---- GL memory ----------------------------------------------------------------------------------
+
+/// Counts the maps of GL memory for the CPU (without GST_MAP_GL) anywhere in the process while it
+/// lives, through the map function of the class of `context`'s default GL memory allocator (the
+/// one GL buffer pools use).
+class CpuMapsOfGlMemory {
+public:
+    explicit CpuMapsOfGlMemory(GstGLContext* context)
+    {
+        GstGLMemoryAllocator* allocator = gst_gl_memory_allocator_get_default(context);
+        klass_ = GST_GL_BASE_MEMORY_ALLOCATOR_GET_CLASS(allocator);
+        gst_object_unref(allocator);
+        original() = klass_->map;
+        klass_->map = counting;
+        count() = 0;
+    }
+    ~CpuMapsOfGlMemory() { klass_->map = original(); }
+    CpuMapsOfGlMemory(const CpuMapsOfGlMemory&) = delete;
+    CpuMapsOfGlMemory& operator=(const CpuMapsOfGlMemory&) = delete;
+    int operator()() const { return count(); }
+
+private:
+    static gpointer counting(GstGLBaseMemory* memory, GstMapInfo* info, gsize size)
+    {
+        if ((info->flags & GST_MAP_GL) == 0)
+            ++count();
+        return original()(memory, info, size);
+    }
+    static std::atomic<int>& count()
+    {
+        static std::atomic<int> n{0};
+        return n;
+    }
+    static GstGLBaseMemoryAllocatorMapFunction& original()
+    {
+        static GstGLBaseMemoryAllocatorMapFunction function = nullptr;
+        return function;
+    }
+    GstGLBaseMemoryAllocatorClass* klass_ = nullptr;
+};
+
+/// A GL context of the test's own on the library's headless EGL display (no window system needed),
+/// given to an element as the application's.
+struct GlContext {
+    GstGLDisplay* display = nullptr;
+    GstGLContext* context = nullptr;
+    std::string why; ///< empty when made
+
+    GlContext()
+    {
+        try {
+            display = GST_GL_DISPLAY(gst_gl_display_egl_new_with_egl_display(defocus::eglDisplay()));
+        } catch (const defocus::GlError& error) {
+            why = error.what();
+            return;
+        }
+        gst_gl_display_filter_gl_api(display, GST_GL_API_OPENGL3);
+        GError* error = nullptr;
+        if (!gst_gl_display_create_context(display, nullptr, &context, &error)) {
+            why = error ? error->message : "no GL context";
+            g_clear_error(&error);
+            return;
+        }
+        gst_gl_display_add_context(display, context);
+    }
+    ~GlContext()
+    {
+        gst_clear_object(&context);
+        gst_clear_object(&display);
+    }
+    void give(GstElement* element) const
+    {
+        GstContext* shared = gst_context_new(GST_GL_DISPLAY_CONTEXT_TYPE, TRUE);
+        gst_context_set_gl_display(shared, display);
+        gst_element_set_context(element, shared);
+        gst_context_unref(shared);
+        GstContext* app = gst_context_new("gst.gl.app_context", TRUE);
+        gst_structure_set(gst_context_writable_structure(app), "context", GST_TYPE_GL_CONTEXT, context, nullptr);
+        gst_element_set_context(element, app);
+        gst_context_unref(app);
+    }
+    /// A buffer of GL memory of `caps` holding `image` (tightly packed rows), uploaded on its
+    /// first map for GL.
+    GstBuffer* buffer(const std::string& caps, const cv::Mat& image, GstClockTime pts) const
+    {
+        GstCaps* parsed = gst_caps_from_string(caps.c_str());
+        GstVideoInfo info;
+        gst_video_info_from_caps(&info, parsed);
+        GstBufferPool* pool = gst_gl_buffer_pool_new(context);
+        GstStructure* config = gst_buffer_pool_get_config(pool);
+        gst_buffer_pool_config_set_params(config, parsed, static_cast<guint>(info.size), 1, 1);
+        gst_buffer_pool_set_config(pool, config);
+        gst_buffer_pool_set_active(pool, TRUE);
+        GstBuffer* buffer = nullptr;
+        gst_buffer_pool_acquire_buffer(pool, &buffer, nullptr);
+        GstVideoFrame frame;
+        if (buffer && gst_video_frame_map(&frame, &info, buffer, GST_MAP_WRITE)) {
+            const auto row = static_cast<size_t>(image.cols) * image.elemSize();
+            for (int y = 0; y < image.rows; ++y)
+                std::memcpy(static_cast<guint8*>(GST_VIDEO_FRAME_PLANE_DATA(&frame, 0)) +
+                                y * GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 0),
+                            image.ptr(y), row);
+            gst_video_frame_unmap(&frame);
+        }
+        // The buffer outlives its pool's activity (a copy of the reference, not the pool's).
+        GstBuffer* copy = buffer ? gst_buffer_copy_deep(buffer) : nullptr;
+        if (buffer)
+            gst_buffer_unref(buffer);
+        gst_buffer_pool_set_active(pool, FALSE);
+        gst_object_unref(pool);
+        gst_caps_unref(parsed);
+        if (copy) {
+            GST_BUFFER_PTS(copy) = pts;
+            GST_BUFFER_DURATION(copy) = kFrame;
+        }
+        return copy;
+    }
+};
+
+std::string glCaps(const char* format, cv::Size size)
+{
+    return "video/x-raw(memory:GLMemory),format=" + std::string(format) + ",width=" + std::to_string(size.width) +
+           ",height=" + std::to_string(size.height) + ",framerate=30/1,texture-target=2D";
+}
+
+// Defects caught: the element mapping a GL frame for the CPU (a download of the colour, depth or
+// output, as the system-memory path's gst_video_frame_map would do), an output without a sync
+// point for the next element, or GL memory filtered into another image than the library's.
+TEST_F(GstDefocus, GlMemoryInAndOutIsNeverMappedForTheCpu)
+{
+    const GlContext gl;
+    if (!gl.why.empty())
+        GTEST_SKIP() << "no GL context for GStreamer: " << gl.why;
+    Element e(kLens);
+    gl.give(e.element);
+    const std::string colorCaps = glCaps("BGRA", frame_.bgr.size());
+    gst_harness_set_src_caps_str(e.color, colorCaps.c_str());
+    const std::string depthCaps = glCaps("GRAY16_LE", frame_.depth16.size());
+    gst_harness_set_src_caps_str(e.depth, depthCaps.c_str());
+    gst_harness_set_sink_caps_str(e.color, "video/x-raw(memory:GLMemory),format=RGBA,texture-target=2D");
+    cv::Mat bgra;
+    cv::cvtColor(frame_.bgr, bgra, cv::COLOR_BGR2BGRA);
+    std::vector<GstBuffer*> colour, depth;
+    for (int i = 0; i < 2; ++i) {
+        colour.push_back(gl.buffer(colorCaps, bgra, i * kFrame));
+        depth.push_back(gl.buffer(depthCaps, frame_.depth16, i * kFrame));
+        ASSERT_TRUE(colour.back() && depth.back());
+    }
+
+    const CpuMapsOfGlMemory cpuMaps(gl.context);
+    std::vector<GstBuffer*> out;
+    for (int i = 0; i < 2; ++i) {
+        ASSERT_EQ(gst_harness_push(e.color, colour[static_cast<size_t>(i)]), GST_FLOW_OK);
+        ASSERT_EQ(gst_harness_push(e.depth, depth[static_cast<size_t>(i)]), GST_FLOW_OK);
+        out.push_back(gst_harness_pull(e.color));
+        ASSERT_NE(out.back(), nullptr);
+    }
+    EXPECT_EQ(cpuMaps(), 0) << "the element mapped GL memory for the CPU";
+    for (int i = 0; i < 2; ++i) {
+        GstBuffer* buffer = out[static_cast<size_t>(i)];
+        EXPECT_EQ(GST_BUFFER_PTS(buffer), i * kFrame);
+        ASSERT_TRUE(gst_buffer_n_memory(buffer) > 0 && gst_is_gl_memory(gst_buffer_peek_memory(buffer, 0)));
+        // A fence (GLsync) in the sync meta: a meta the pool added and nobody set has none.
+        const GstGLSyncMeta* sync = gst_buffer_get_gl_sync_meta(buffer);
+        EXPECT_TRUE(sync && sync->data) << "no sync point on the output";
+        // Read back here, by the test (a map the counter sees: it counts).
+        GstVideoInfo info;
+        gst_video_info_set_format(&info, GST_VIDEO_FORMAT_RGBA, static_cast<guint>(frame_.bgr.cols),
+                                  static_cast<guint>(frame_.bgr.rows));
+        GstVideoFrame frame;
+        ASSERT_TRUE(gst_video_frame_map(&frame, &info, buffer, GST_MAP_READ));
+        const cv::Mat rgba(frame_.bgr.rows, frame_.bgr.cols, CV_8UC4, GST_VIDEO_FRAME_PLANE_DATA(&frame, 0),
+                           static_cast<size_t>(GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 0)));
+        cv::Mat bgr;
+        cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
+        gst_video_frame_unmap(&frame);
+        EXPECT_TRUE(identical(bgr, library(lensSettings(), frame_.bgr, frame_.depth16))) << "frame " << i;
+        gst_buffer_unref(buffer);
+    }
+    EXPECT_GE(cpuMaps(), 2) << "the counter does not see maps for the CPU";
 }
 
 } // namespace

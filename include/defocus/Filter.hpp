@@ -11,8 +11,10 @@
 // Filter's EGL context current on the calling thread for its duration and then puts back what
 // was current there before (another EGL context of the caller's, or none), so no release() is
 // needed between threads. Different Filters are independent and may run on different threads
-// at once. check(), version(), eglDevices(), probeRenderer() and the structs are plain data and
-// functions that any thread may call (probeRenderer() makes and drops a context of its own).
+// at once. A Filter made with ContextOptions::callerContext makes no context current: the
+// caller's must be current on the calling thread for every call and the destructor. check(),
+// version(), eglDevices(), probeRenderer() and the structs are plain data and functions that any
+// thread may call (probeRenderer() makes and drops a context of its own).
 // Several clips, one after the other, can share one Filter (one context, one shader build):
 // setSettings() and reset() between them, as `defocus --batch` does.
 #pragma once
@@ -94,6 +96,30 @@ struct ContextOptions {
     /// CUDA_VISIBLE_DEVICES makes CUDA's first, else the first device that works, else Mesa's
     /// surfaceless platform. The command line's --egl-device.
     std::optional<int> eglDevice;
+    /// Render on the OpenGL context current on the thread that makes the Filter (an EGL or GLX
+    /// context of the caller's, e.g. a GstGLContext on its own thread) and make none: eglDevice is
+    /// not used. It must be OpenGL 4.5 core or later (GlError otherwise), current whenever the
+    /// Filter is called or destroyed, and share no state the caller relies on across a call but
+    /// what the Filter documents (processTextures()). The Filter's GL objects live in it.
+    bool callerContext = false;
+};
+
+/// One frame in GL_TEXTURE_2D textures of the caller's context, for Filter::processTextures().
+/// Texture formats are those GStreamer's GL memory uses for these video formats.
+struct GlFrame {
+    enum class Order { Rgba, Bgra };
+    enum class DepthFormat {
+        R16,   ///< GL_R16: 16-bit units, Settings::depthScale per metre
+        Rg8Le, ///< GL_RG8 holding 16-bit little-endian units (red the low byte): GStreamer's GRAY16_LE
+        R32F   ///< GL_R32F: metres
+    };
+    unsigned color = 0;       ///< GL_RGBA8 (not an sRGB format), sRGB-encoded values, alpha ignored
+    Order colorOrder = Order::Rgba; ///< Bgra: red holds blue (GStreamer's BGRA/BGRx in GL memory)
+    unsigned depth = 0;       ///< any size with the colour's aspect ratio; 0 = all in focus
+    DepthFormat depthFormat = DepthFormat::R16;
+    unsigned output = 0;      ///< GL_RGBA8 at the colour's size, written whole: sRGB-encoded, alpha 1
+    Order outputOrder = Order::Rgba;
+    int width = 0, height = 0; ///< the colour's and the output's size, pixels
 };
 
 /// One EGL device of the machine (the command line's `--info` lists them).
@@ -116,6 +142,11 @@ struct RendererInfo {
     bool timerQueries = false; ///< the driver has GPU timer queries (Timings::gpu is filled)
 };
 
+/// The EGL display (an initialised EGLDisplay) a Filter with a context of its own renders on
+/// here, kept open for the rest of the process: for a caller that must share one, such as
+/// GStreamer's GL library on a machine with no window system and no /dev/dri
+/// (gst_gl_display_egl_new_with_egl_display). Throws GlError where no context can be made.
+DEFOCUS_API void* eglDisplay(const ContextOptions& context = {});
 /// The EGL devices of this machine; empty where EGL cannot enumerate them.
 DEFOCUS_API std::vector<EglDevice> eglDevices();
 /// Makes an OpenGL 4.5 context as a Filter would (no shaders compiled), says what it is and
@@ -160,6 +191,21 @@ public:
     /// between frames; 0 = unknown, taken as 1/30 s). Throws InputError for images it cannot
     /// take and SettingsError when an automatic focus comes out of range.
     cv::Mat process(const cv::Mat& color, const cv::Mat& depth, double timestampS = 0.0);
+    /// process() for a frame in textures of the caller's context (ContextOptions::callerContext;
+    /// otherwise it throws InputError): the same result as process() of the same images, byte for
+    /// byte, into `frame.output` (Settings::output is taken as Srgb8). Call it on the thread where
+    /// that context is current. The CPU's depth preparation and scene analysis read the colour and
+    /// depth back (glGetTextureImage); the output is rendered on the GPU, except frames all in
+    /// focus and the depth and coc views, which are uploaded. The call waits for no fence: the
+    /// caller orders its own work around it (GStreamer: GstGLSyncMeta). GL state: it puts back the
+    /// framebuffer bindings, viewport, program, vertex array, active texture, the 2D texture and
+    /// sampler bindings of units 0-7, pixel-store alignment and row length, the pixel pack and
+    /// unpack, draw-indirect and generic uniform and shader-storage buffers, blend function and
+    /// equation, colour mask and the enables of FRAMEBUFFER_SRGB, BLEND, DEPTH_TEST, STENCIL_TEST,
+    /// SCISSOR_TEST and CULL_FACE (construction, process() and the other calls on such a Filter
+    /// do the same); it leaves the indexed uniform and shader-storage buffer bindings changed.
+    /// Throws InputError for textures that are not 2D of the format and size stated.
+    void processTextures(const GlFrame& frame, double timestampS = 0.0);
 
     /// The last frame's timings and plan (valid after the first process()).
     const FrameReport& lastFrame() const;
