@@ -146,6 +146,19 @@ struct Pipeline::Impl {
     float maxCocPx = 0.0f;
     FrameTimings timings;
     Clock::time_point frameStart;
+    /// Readback buffers collected and free again, for the next reads of their size.
+    std::vector<gl::ReadbackBuffer> spareReadbacks;
+    /// A spare readback buffer of at least `bytes` (those too small are dropped), or a new one.
+    gl::ReadbackBuffer takeReadbackBuffer(GLsizeiptr bytes)
+    {
+        while (!spareReadbacks.empty()) {
+            gl::ReadbackBuffer spare = std::move(spareReadbacks.back());
+            spareReadbacks.pop_back();
+            if (spare.size() >= bytes)
+                return spare;
+        }
+        return gl::ReadbackBuffer(bytes, "readback");
+    }
 
     // The last frame, kept until its passes have run (they are skipped when all is in focus
     // and the composite is all that is read).
@@ -593,11 +606,46 @@ void Pipeline::Impl::finishTimings(Clock::time_point readStart)
     timings.totalMs = msSince(frameStart);
 }
 
+struct PendingRead::State {
+    cv::Mat ready;              ///< the image, where it needed no read from the GPU
+    gl::ReadbackBuffer buffer;  ///< otherwise the read in flight
+    cv::Size size;
+    Encoding encoding = Encoding::Srgb8;
+    View view = View::Composite;
+    float low = 0.0f, high = 0.0f; ///< the legend's ends (depth and CoC views)
+    FrameTimings timings;
+};
+
+PendingRead::PendingRead() = default;
+PendingRead::~PendingRead() = default;
+PendingRead::PendingRead(PendingRead&&) noexcept = default;
+PendingRead& PendingRead::operator=(PendingRead&&) noexcept = default;
+
+const FrameTimings& PendingRead::timings() const
+{
+    static const FrameTimings none;
+    return state_ ? state_->timings : none;
+}
+
 cv::Mat Pipeline::read(View view, Encoding encoding)
+{
+    PendingRead pending = readAsync(view, encoding);
+    cv::Mat image = collect(pending);
+    impl_->timings = pending.timings();
+    return image;
+}
+
+PendingRead Pipeline::readAsync(View view, Encoding encoding)
 {
     Impl& p = *impl_;
     CV_Assert(!p.size.empty());
     const auto start = Clock::now();
+    PendingRead pending;
+    pending.state_ = std::make_unique<PendingRead::State>();
+    PendingRead::State& read = *pending.state_;
+    read.size = p.size;
+    read.encoding = encoding;
+    read.view = view;
     if (view == View::Composite && !p.rendered) {
         // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
         // CoC pass's clean-up (no NaN, no negatives, within the target's range).
@@ -605,28 +653,44 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
         const cv::Mat linear = srgbInput ? cv::Mat()
                                          : sanitizeLinear(p.color, CocPass::largestColor(
                                                                         p.quality.targetFormat == TargetFormat::Rgba16F));
-        cv::Mat image;
         if (encoding == Encoding::Srgb8)
-            image = srgbInput ? p.color.clone() : encodeSrgb(linear);
+            read.ready = srgbInput ? p.color.clone() : encodeSrgb(linear);
         else
-            image = srgbInput ? decodeSrgb(p.color) : linear;
+            read.ready = srgbInput ? decodeSrgb(p.color) : linear;
         p.timings.readbackMs = msSince(start);
         p.timings.totalMs = msSince(p.frameStart);
-        return image;
+        read.timings = p.timings;
+        return pending;
     }
-    float low = 0.0f, high = 0.0f;
-    Target& out = p.renderOutput(view, encoding, low, high);
-    cv::Mat image(p.size, encoding == Encoding::Srgb8 ? CV_8UC3 : CV_32FC3);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, out.framebuffer.id());
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, p.size.width, p.size.height, GL_BGR,
-                 encoding == Encoding::Srgb8 ? GL_UNSIGNED_BYTE : GL_FLOAT, image.data);
+    const Target& out = p.renderOutput(view, encoding, read.low, read.high);
+    // Into a buffer of the pool behind a fence: the pixels travel while the caller goes on.
+    const GLsizeiptr bytes = static_cast<GLsizeiptr>(p.size.area()) * 3 *
+                             static_cast<GLsizeiptr>(encoding == Encoding::Srgb8 ? 1 : sizeof(float));
+    read.buffer = p.takeReadbackBuffer(bytes);
+    read.buffer.readPixels(out.framebuffer.id(), p.size.width, p.size.height, GL_BGR,
+                           encoding == Encoding::Srgb8 ? GL_UNSIGNED_BYTE : GL_FLOAT);
     p.finishTimings(start);
+    read.timings = p.timings;
+    return pending;
+}
 
-    if (view == View::Depth)
-        drawLegend(image, LegendKind::DepthMetres, low, high);
-    else if (view == View::Coc)
-        drawLegend(image, LegendKind::SignedCocPixels, -high, high);
+cv::Mat Pipeline::collect(PendingRead& pending)
+{
+    CV_Assert(pending.state_);
+    PendingRead::State& read = *pending.state_;
+    if (!read.ready.empty())
+        return std::exchange(read.ready, cv::Mat());
+    const auto start = Clock::now();
+    cv::Mat image(read.size, read.encoding == Encoding::Srgb8 ? CV_8UC3 : CV_32FC3);
+    read.buffer.copyTo(image.data, static_cast<GLsizeiptr>(image.total() * image.elemSize()));
+    impl_->spareReadbacks.push_back(std::move(read.buffer));
+    if (read.view == View::Depth)
+        drawLegend(image, LegendKind::DepthMetres, read.low, read.high);
+    else if (read.view == View::Coc)
+        drawLegend(image, LegendKind::SignedCocPixels, -read.high, read.high);
+    const double waitedMs = msSince(start);
+    read.timings.readbackMs += waitedMs;
+    read.timings.totalMs += waitedMs;
     return image;
 }
 

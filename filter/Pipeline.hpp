@@ -48,6 +48,24 @@ struct FrameTimings {
     std::size_t gpuFrame = 0;
 };
 
+/// A view of a processed frame on its way back from the GPU (Pipeline::readAsync): the pixels
+/// are read into a buffer behind a fence, and Pipeline::collect copies them out. Move-only; it
+/// holds GL objects, so it ends with the pipeline's context current.
+class PendingRead {
+public:
+    PendingRead();
+    ~PendingRead();
+    PendingRead(PendingRead&&) noexcept;
+    PendingRead& operator=(PendingRead&&) noexcept;
+    /// The frame's timings: readback and total so far at readAsync(), complete after collect().
+    const FrameTimings& timings() const;
+
+private:
+    friend class Pipeline;
+    struct State;
+    std::unique_ptr<State> state_;
+};
+
 class Pipeline {
 public:
     /// Compiles every pass; throws gl::ShaderError on a driver that rejects a shader.
@@ -69,6 +87,12 @@ public:
     /// passes rendered is copied on the GPU (timer scope "output-copy"); a frame all in focus and
     /// the depth and coc views, whose legend is drawn on the CPU, are read() and uploaded.
     void readInto(View view, unsigned texture, bool bgra);
+    /// read() in two halves, so that the next frame can be processed while this one is on its
+    /// way back: readAsync() renders `view` and queues its read (a frame all in focus is ready
+    /// at once); collect() waits for it and returns the pixels read() would have. Any number of
+    /// frames may be pending, each collected once, in any order.
+    PendingRead readAsync(View view, Encoding encoding);
+    cv::Mat collect(PendingRead& read);
     /// process() + read() in one call.
     cv::Mat run(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
                 View view = View::Composite, Encoding encoding = Encoding::Srgb8);
@@ -85,7 +109,7 @@ public:
     /// process(), so asking runs nothing. At the colour's size; a frame all in focus counts it
     /// on the depth as given (the same share up to the nearest-neighbour resize).
     double invalidDepthFraction() const;
-    /// Timings of the last process() + read().
+    /// Timings of the last process() + read() (of the last readAsync(), without its collect()).
     const FrameTimings& timings() const;
     /// GPU times of the last frame, waiting for them (call once at the end of a stream).
     std::vector<PassTime> drainGpuTimes();

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <limits>
 #include <optional>
 #include <utility>
@@ -193,11 +194,21 @@ struct Filter::Impl {
     /// The last process()'s frame and lens, for contactSheet() to process it again.
     std::optional<Frame> lastFrame;
     LensSettings lastLens;
+    /// submit()'s frames on their way back, oldest first, each with its report.
+    struct InFlight {
+        PendingRead read;
+        FrameReport report;
+    };
+    std::deque<InFlight> inFlight;
 
     explicit Impl(std::optional<gl::EglContext> made) : context(std::move(made)) {}
 
     /// report from the pipeline's last frame, frame number `index`.
-    void fillReport(std::size_t index);
+    void fillReport(std::size_t index) { fillReport(index, pipeline->timings(), report); }
+    void fillReport(std::size_t index, const FrameTimings& t, FrameReport& r) const;
+    /// The frame process() and submit() filter from the caller's images, and its lens (the
+    /// autofocus stepped); throws InputError and SettingsError as process() documents.
+    Frame admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens);
 
     /// The context current on the calling thread until the end of the call, whichever thread
     /// used the Filter before; then what was current there before is again. On the caller's
@@ -223,6 +234,7 @@ struct Filter::Impl {
     {
         try {
             const auto bound = current();
+            inFlight.clear();
             pipeline.reset();
         } catch (const Error&) {
             // Another thread is inside a call on this Filter (a caller's bug): the GL objects
@@ -312,9 +324,9 @@ const Settings& Filter::settings() const
     return impl_->settings;
 }
 
-cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens)
 {
-    Impl& p = *impl_;
+    Impl& p = *this;
     if (color.empty())
         throw InputError("colour image is empty");
     Frame frame;
@@ -349,29 +361,40 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     frame.timestampS = timestampS;
     frame.name = fmt::format("frame {}", p.frames);
 
-    LensSettings lens = p.lens;
+    frameLens = p.lens;
     switch (p.settings.autofocus.mode) {
     case AutofocusOptions::Mode::Off: break;
     case AutofocusOptions::Mode::FirstFrame:
         if (!p.focusChosen) {
             p.firstFrameFocusM = centreDepth(frame.depth, kAutoWindow, kAutoFallbackM);
-            LensSettings measured = lens;
+            LensSettings measured = frameLens;
             measured.focusM = p.firstFrameFocusM;
             if (const auto issues = validate(measured); !issues.empty())
                 throw SettingsError(fmt::format("automatic focus: {}", issues.front().message));
             p.focusChosen = true;
         }
-        lens.focusM = p.firstFrameFocusM;
+        frameLens.focusM = p.firstFrameFocusM;
         break;
     case AutofocusOptions::Mode::Follow: {
         const double dt = frameInterval(p.previousTimestamp, timestampS, kFallbackFrameS);
-        lens.focusM = frame.depth.empty() ? p.follow->advance(dt) : p.follow->update(frame.depth, dt);
+        frameLens.focusM = frame.depth.empty() ? p.follow->advance(dt) : p.follow->update(frame.depth, dt);
         // Nearer than the lens can focus: the nearest it can.
-        lens.focusM = std::max(lens.focusM, lens.focalLengthMm * 1e-3 * 1.01);
+        frameLens.focusM = std::max(frameLens.focusM, frameLens.focalLengthMm * 1e-3 * 1.01);
         break;
     }
     }
     p.previousTimestamp = timestampS;
+    return frame;
+}
+
+cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+{
+    Impl& p = *impl_;
+    if (!p.inFlight.empty())
+        throw Error(fmt::format("defocus::Filter::process(): {} frames in flight; receive() them first",
+                                p.inFlight.size()));
+    LensSettings lens;
+    Frame frame = p.admit(color, depth, timestampS, lens);
 
     const auto bound = p.current();
     const Encoding encoding =
@@ -390,11 +413,9 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     return out;
 }
 
-void Filter::Impl::fillReport(std::size_t index)
+void Filter::Impl::fillReport(std::size_t index, const FrameTimings& t, FrameReport& r) const
 {
-    Impl& p = *this;
-    const FrameTimings& t = p.pipeline->timings();
-    FrameReport& r = p.report;
+    const Impl& p = *this;
     r.index = index;
     r.focusM = p.lastLens.focusM;
     r.timings.totalMs = t.totalMs;
@@ -440,9 +461,49 @@ std::vector<Timings::Pass> Filter::finishGpuTimings()
     return out;
 }
 
+void Filter::submit(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+{
+    Impl& p = *impl_;
+    if (p.textureFrame || !p.context)
+        throw Error("defocus::Filter::submit(): frames in GL textures go through processTextures()");
+    LensSettings lens;
+    Frame frame = p.admit(color, depth, timestampS, lens);
+    const auto bound = p.current();
+    const Encoding encoding =
+        p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
+    p.pipeline->process(frame, lens, p.quality);
+    Impl::InFlight entry{p.pipeline->readAsync(toView(p.settings.view), encoding), {}};
+    p.lastFrame = std::move(frame);
+    p.lastLens = lens;
+    p.fillReport(p.frames++, entry.read.timings(), entry.report);
+    p.inFlight.push_back(std::move(entry));
+}
+
+std::optional<cv::Mat> Filter::receive()
+{
+    Impl& p = *impl_;
+    if (p.inFlight.empty())
+        return std::nullopt;
+    const auto bound = p.current();
+    Impl::InFlight& oldest = p.inFlight.front();
+    cv::Mat image = p.pipeline->collect(oldest.read);
+    p.report = std::move(oldest.report);
+    p.report.timings.readbackMs = oldest.read.timings().readbackMs;
+    p.report.timings.totalMs = oldest.read.timings().totalMs;
+    p.inFlight.pop_front();
+    return image;
+}
+
+std::size_t Filter::framesInFlight() const
+{
+    return impl_->inFlight.size();
+}
+
 cv::Mat Filter::contactSheet()
 {
     Impl& p = *impl_;
+    if (!p.inFlight.empty())
+        throw Error("defocus::Filter::contactSheet(): frames in flight; receive() them first");
     if (!p.lastFrame)
         throw InputError("contact sheet: no frame processed yet");
     const auto bound = p.current();
@@ -465,6 +526,10 @@ cv::Mat Filter::contactSheet()
 void Filter::reset()
 {
     Impl& p = *impl_;
+    if (!p.inFlight.empty()) {
+        const auto bound = p.current();
+        p.inFlight.clear();
+    }
     p.frames = 0;
     p.lastFrame.reset();
     p.focusChosen = false;

@@ -485,3 +485,67 @@ TEST(LibrarySource, SyntheticSceneRendersInItsOwnContext)
     settings.synthetic = clip;
     EXPECT_THROW(defocus::Source{settings}, defocus::SettingsError);
 }
+
+// Defect caught: frames in flight that come back in another order, with another frame's pixels
+// (a readback buffer reused before it was read, a fence not waited for), with another frame's
+// report, or different from one frame at a time, on any preset or kernel; a frame all in focus
+// (ready at once) overtaking the blurred one before it.
+TEST(LibraryInFlight, FramesInFlightAreTheFramesOneAtATime)
+{
+    std::vector<std::pair<cv::Mat, cv::Mat>> frames;
+    for (int line : {4, 5, 6, 7, 8}) {
+        const Pair pair = bundled(line);
+        frames.emplace_back(cv::imread(pair.color.string(), cv::IMREAD_COLOR),
+                            cv::imread(pair.depth.string(), cv::IMREAD_UNCHANGED));
+    }
+    cv::Mat flat(frames[2].second.size(), CV_32F, cv::Scalar(1.0f)); // frame 2: all in focus at 1 m
+    frames[2].second = flat;
+    for (const auto preset : {defocus::Quality::Preset::Fast, defocus::Quality::Preset::Balanced,
+                              defocus::Quality::Preset::High})
+        for (const auto kernel : {defocus::Quality::Hexagon::Rhombi, defocus::Quality::Hexagon::McIntosh}) {
+            defocus::Settings settings;
+            settings.depthScale = 5000;
+            settings.lens.focusM = 1.0;
+            settings.lens.fNumber = 1.4;
+            settings.quality.preset = preset;
+            settings.quality.hexagon = kernel;
+            const std::string what = std::string(defocus::qualityName(preset)) +
+                                     (kernel == defocus::Quality::Hexagon::Rhombi ? ", rhombi" : ", mcintosh");
+            std::optional<defocus::Filter> serial, pipelined;
+            try {
+                serial.emplace(settings);
+                pipelined.emplace(settings);
+            } catch (const defocus::GlError& error) {
+                GTEST_SKIP() << "no OpenGL 4.5: " << error.what();
+            }
+            std::vector<cv::Mat> expected;
+            std::vector<defocus::Plan> plans;
+            for (std::size_t i = 0; i < frames.size(); ++i) {
+                settings.lens.focusM = 1.0 + 0.25 * static_cast<double>(i % 2) * (i == 2 ? 0 : 1); // frames differ
+                serial->setSettings(settings);
+                expected.push_back(serial->process(frames[i].first, frames[i].second));
+                plans.push_back(serial->lastFrame().plan);
+            }
+            std::size_t received = 0;
+            const auto check = [&](const std::optional<cv::Mat>& image) {
+                ASSERT_TRUE(image) << what;
+                EXPECT_TRUE(identical(*image, expected[received])) << what << ", frame " << received;
+                EXPECT_EQ(pipelined->lastFrame().index, received) << what;
+                EXPECT_EQ(pipelined->lastFrame().plan.allInFocus, plans[received].allInFocus) << what;
+                EXPECT_EQ(pipelined->lastFrame().plan.blurTiles, plans[received].blurTiles) << what;
+                ++received;
+            };
+            for (std::size_t i = 0; i < frames.size(); ++i) {
+                settings.lens.focusM = 1.0 + 0.25 * static_cast<double>(i % 2) * (i == 2 ? 0 : 1);
+                pipelined->setSettings(settings);
+                pipelined->submit(frames[i].first, frames[i].second);
+                if (pipelined->framesInFlight() >= defocus::Filter::kFramesInFlight)
+                    check(pipelined->receive());
+            }
+            EXPECT_THROW(pipelined->process(frames[0].first, frames[0].second), defocus::Error);
+            while (pipelined->framesInFlight() > 0)
+                check(pipelined->receive());
+            EXPECT_EQ(received, frames.size());
+            EXPECT_FALSE(pipelined->receive());
+        }
+}

@@ -3,6 +3,9 @@
 #include "filter/gl/Objects.hpp"
 
 #include <cassert>
+#include <cstring>
+#include <stdexcept>
+#include <utility>
 
 namespace defocus::gl {
 
@@ -133,6 +136,71 @@ void StorageBuffer::read(void* data, GLsizeiptr bytes) const
 {
     assert(bytes <= size_);
     glGetNamedBufferSubData(id(), 0, bytes, data);
+}
+
+ReadbackBuffer::ReadbackBuffer(GLsizeiptr size, std::string_view name) : size_(size)
+{
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    handle_ = Handle<deleteBuffer>(id);
+    glNamedBufferStorage(id, size, nullptr, GL_MAP_READ_BIT | GL_CLIENT_STORAGE_BIT);
+    label(GL_BUFFER, id, name);
+}
+
+ReadbackBuffer::~ReadbackBuffer()
+{
+    dropFence();
+}
+
+ReadbackBuffer::ReadbackBuffer(ReadbackBuffer&& other) noexcept
+    : handle_(std::move(other.handle_)), size_(std::exchange(other.size_, 0)), fence_(std::exchange(other.fence_, nullptr))
+{
+}
+
+ReadbackBuffer& ReadbackBuffer::operator=(ReadbackBuffer&& other) noexcept
+{
+    if (this != &other) {
+        dropFence();
+        handle_ = std::move(other.handle_);
+        size_ = std::exchange(other.size_, 0);
+        fence_ = std::exchange(other.fence_, nullptr);
+    }
+    return *this;
+}
+
+void ReadbackBuffer::dropFence() noexcept
+{
+    if (fence_ != nullptr)
+        glDeleteSync(std::exchange(fence_, nullptr));
+}
+
+void ReadbackBuffer::readPixels(GLuint framebuffer, int width, int height, GLenum format, GLenum type)
+{
+    dropFence();
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, handle_.id());
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width, height, format, type, nullptr);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    fence_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush(); // the read starts now, not when the next frame's commands push it out
+}
+
+void ReadbackBuffer::copyTo(void* data, GLsizeiptr bytes)
+{
+    assert(bytes <= size_);
+    if (fence_ != nullptr) {
+        // The first wait flushes; later ones wait a second at a time.
+        GLbitfield flags = GL_SYNC_FLUSH_COMMANDS_BIT;
+        while (glClientWaitSync(fence_, flags, 1'000'000'000) == GL_TIMEOUT_EXPIRED)
+            flags = 0;
+        dropFence();
+    }
+    const void* mapped = glMapNamedBufferRange(handle_.id(), 0, bytes, GL_MAP_READ_BIT);
+    if (mapped == nullptr)
+        throw std::runtime_error("glMapNamedBufferRange failed on a readback buffer");
+    std::memcpy(data, mapped, static_cast<std::size_t>(bytes));
+    glUnmapNamedBuffer(handle_.id());
 }
 
 VertexArray VertexArray::create()

@@ -154,6 +154,34 @@ private:
     GLsizeiptr size_ = 0;
 };
 
+/// A pixel pack buffer that glReadPixels fills behind a fence: the read is queued with the
+/// frame's passes and returns at once; copyTo() waits for the fence (not for the whole GPU) and
+/// copies the pixels out.
+class ReadbackBuffer {
+public:
+    ReadbackBuffer() = default;
+    ReadbackBuffer(GLsizeiptr size, std::string_view name);
+    ~ReadbackBuffer();
+    ReadbackBuffer(ReadbackBuffer&& other) noexcept;
+    ReadbackBuffer& operator=(ReadbackBuffer&& other) noexcept;
+    ReadbackBuffer(const ReadbackBuffer&) = delete;
+    ReadbackBuffer& operator=(const ReadbackBuffer&) = delete;
+
+    GLsizeiptr size() const { return size_; }
+    /// Queues a read of the `width` x `height` pixels of `framebuffer`'s colour attachment as
+    /// `format`/`type`, rows packed with no padding, and fences it. Needs width * height * pixel
+    /// size <= size().
+    void readPixels(GLuint framebuffer, int width, int height, GLenum format, GLenum type);
+    /// Waits for the last readPixels() and copies its first `bytes` into `data`.
+    void copyTo(void* data, GLsizeiptr bytes);
+
+private:
+    void dropFence() noexcept;
+    Handle<deleteBuffer> handle_;
+    GLsizeiptr size_ = 0;
+    GLsync fence_ = nullptr;
+};
+
 /// The empty vertex array that a full-screen triangle drawn from gl_VertexID needs in core GL.
 class VertexArray {
 public:

@@ -207,6 +207,23 @@ public:
     /// Throws InputError for textures that are not 2D of the format and size stated.
     void processTextures(const GlFrame& frame, double timestampS = 0.0);
 
+    /// Frames in flight, for throughput (as FFmpeg's send/receive): submit() takes a frame as
+    /// process() does and returns once its passes and its read are queued, without waiting for
+    /// the GPU; receive() returns the oldest submitted frame's result, the bytes process() would
+    /// have returned for it, waiting for it, and makes lastFrame() that frame's report (its
+    /// totalMs and readbackMs: the time spent on it in both calls); nullopt when none is in
+    /// flight. With kFramesInFlight submitted before each receive(), the next frame's work on
+    /// the CPU (depth, analysis, upload) overlaps the GPU's work and read of the one before.
+    /// Settings changed between submits apply from the next submit. While frames are in flight,
+    /// process() and contactSheet() throw Error; reset() drops them. Not for a Filter on the
+    /// caller's context (processTextures()).
+    void submit(const cv::Mat& color, const cv::Mat& depth, double timestampS = 0.0);
+    std::optional<cv::Mat> receive();
+    /// Frames submitted and not yet received.
+    std::size_t framesInFlight() const;
+    /// How many frames to keep submitted for the CPU and the GPU to overlap.
+    static constexpr std::size_t kFramesInFlight = 2;
+
     /// The last frame's timings and plan (valid after the first process()).
     const FrameReport& lastFrame() const;
     /// The GPU times of the last frame, waiting for the GPU (otherwise they come one frame late,
@@ -221,7 +238,8 @@ public:
     /// GPU times stay those of a plain frame (lastFrame().index does not advance). Throws
     /// InputError before the first process().
     cv::Mat contactSheet();
-    /// A new stream: the next frame is frame 0 again, and the autofocus measures afresh.
+    /// A new stream: the next frame is frame 0 again, and the autofocus measures afresh; frames
+    /// still in flight are dropped.
     void reset();
     /// Unbinds the EGL context from the calling thread where it is still bound. Every call
     /// already unbinds it when it returns, so this is never needed to hand the Filter to
