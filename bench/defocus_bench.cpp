@@ -11,6 +11,7 @@
 #include <fstream>
 #include <optional>
 #include <stdexcept>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -26,6 +27,7 @@
 
 #include "bench/BenchCli.hpp"
 #include "bench/BenchPlan.hpp"
+#include "bench/BenchThroughput.hpp"
 #include "bench/BenchTiming.hpp"
 #include "filter/ApiSettings.hpp"
 #include "filter/DepthPrep.hpp"
@@ -606,6 +608,42 @@ CLI::App* declarePlan(CLI::App& app, defocus::PlanOptions& o)
     return sub;
 }
 
+/// `defocus-bench throughput`: one frame at a time against frames in flight (bench/BenchThroughput.hpp).
+CLI::App* declareThroughput(CLI::App& app, defocus::ThroughputOptions& o)
+{
+    CLI::App* sub = app.add_subcommand("throughput", "Frames per second through the public Filter one frame at a "
+                                                     "time and with frames in flight, interleaved in one run, and "
+                                                     "the calling thread's CPU time per frame");
+    sub->add_option("--data", o.data, "TUM RGB-D folder to take frames from")->capture_default_str();
+    sub->add_option_function<std::string>(
+           "--sizes",
+           [&o](const std::string& text) {
+               o.sizes.clear();
+               std::size_t start = 0;
+               while (start <= text.size()) {
+                   const std::size_t comma = std::min(text.find(',', start), text.size());
+                   int width = 0, height = 0;
+                   char x = 0;
+                   std::istringstream in(text.substr(start, comma - start));
+                   if (!(in >> width >> x >> height) || x != 'x' || width < 16 || height < 16 || width > 8192 ||
+                       height > 8192)
+                       throw CLI::ValidationError("--sizes", "'" + text + "' is not WxH,WxH... (16 to 8192 pixels)");
+                   o.sizes.emplace_back(width, height);
+                   start = comma + 1;
+               }
+           },
+           "Frame sizes, WxH comma-separated")
+        ->default_str("640x480,1920x1080");
+    sub->add_option("--quality", o.preset, "Preset: fast, balanced or high")
+        ->check(CLI::IsMember({"fast", "balanced", "high"}))
+        ->capture_default_str();
+    sub->add_option("--frames", o.frames, "Frames per timed pass")->capture_default_str()->check(cli::between(2, 100000));
+    sub->add_option("--passes", o.passes, "Timed passes per way, interleaved")
+        ->capture_default_str()
+        ->check(cli::between(1, 1000));
+    return sub;
+}
+
 /// `defocus-bench accuracy ...` runs the accuracy sweep, built as its own program beside this one,
 /// with the arguments after the subcommand (its --help included).
 int runAccuracy(const std::vector<std::string>& rest, const char* self)
@@ -630,7 +668,7 @@ int main(int argc, char** argv)
     CLI::App app{"defocus-bench: milliseconds per pass and per frame of the defocus pipeline on the bundled TUM "
                  "clip, resized to each size; median and p90 of several runs, for a defocused and an all-in-focus "
                  "scene. Run it from the repository root. The subcommands time the per-frame plan (plan), hold the "
-                 "per-pass timing baseline (timing) and sweep accuracy against a path-traced lens (accuracy); "
+                 "per-pass timing baseline (timing), time frames in flight against one at a time (throughput) and sweep accuracy against a path-traced lens (accuracy); "
                  "each has its own --help."};
     defocus::cli::addVersionFlag(app, "defocus-bench");
     app.require_subcommand(0, 1);
@@ -638,6 +676,8 @@ int main(int argc, char** argv)
     CLI::App* timing = declareTiming(app, timingOptions);
     defocus::PlanOptions planOptions;
     CLI::App* plan = declarePlan(app, planOptions);
+    defocus::ThroughputOptions throughputOptions;
+    CLI::App* throughput = declareThroughput(app, throughputOptions);
     CLI::App* accuracy = app.add_subcommand("accuracy", "Error against a path-traced thin lens and time per frame of "
                                                         "every method (defocus-bench-accuracy; 'accuracy --help' "
                                                         "lists its options)");
@@ -686,6 +726,8 @@ int main(int argc, char** argv)
             return defocus::runTimingComparison(timingOptions);
         if (plan->parsed())
             return defocus::runPlanComparison(planOptions);
+        if (throughput->parsed())
+            return defocus::runThroughput(throughputOptions);
         std::string commandLine = "defocus-bench";
         for (int i = 1; i < argc; ++i)
             commandLine += std::string(" ") + argv[i];

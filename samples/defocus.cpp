@@ -17,6 +17,7 @@
 #include <csignal>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -370,6 +371,45 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
     cv::Mat sheet; // --contact-sheet's image, once its frame has passed
     std::size_t current = 0; // the input's frame being read or processed, counted as --start counts, for messages
 
+    // Frames in flight (Filter::submit/receive): while one is on its way back from the GPU the
+    // next is read and prepared. A camera's frames go one at a time (a frame in flight would be
+    // a frame of latency), and so does the contact sheet's frame (it is processed again).
+    const std::size_t inFlight = source.isLive() ? 1 : Filter::kFramesInFlight;
+    struct Waiting {
+        Frame frame;
+        double focusM = 0.0;
+    };
+    std::deque<Waiting> waiting; // submitted, in order
+    std::size_t delivered = 0;
+    // A frame back from the filter: to the sink, the explanation, the timings, the progress.
+    const auto deliver = [&](const cv::Mat& image, const Waiting& w) {
+        if (options.explain)
+            std::printf("frame %zu: focus %.4f m\n", w.frame.index, w.focusM);
+        sink.writeFrame(image, w.frame);
+        frameSize = image.size();
+        const FrameReport& done = filter.lastFrame();
+        if (options.explain)
+            std::printf("frame %zu: %s\n", w.frame.index, done.plan.explain.c_str());
+        const Timings& t = done.timings;
+        timingLog.frame(t, w.frame.index, done.index);
+        for (const auto& pass : t.gpu)
+            passMs[pass.name] += pass.ms;
+        totalMs += t.totalMs;
+        uploadMs += t.uploadMs;
+        readbackMs += t.readbackMs;
+        ++timed;
+        progress.update(++delivered);
+    };
+    const auto receiveOne = [&] {
+        const std::optional<cv::Mat> image = filter.receive();
+        deliver(*image, waiting.front());
+        waiting.pop_front();
+    };
+    const auto receiveAll = [&] {
+        while (!waiting.empty())
+            receiveOne();
+    };
+
     int status = kExitDone;
     try {
         while (!cli::stopRequested() && (!options.frames || framesIn < *options.frames)) {
@@ -411,31 +451,25 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
                     throw std::runtime_error(fmt::format("focus {:.3f} m at frame {}: {}", lens.focusM, frame->index,
                                                          issues.front()));
             }
-            if (options.explain)
-                std::printf("frame %zu: focus %.4f m\n", frame->index, lens.focusM);
             if (!settingsGiven || lens.focusM != filter.settings().lens.focusM) {
                 filter.setSettings(settings); // checked: by finishOptions, or above
                 settingsGiven = true;
             }
-            const cv::Mat image = filter.process(frame->color, frame->depth, frame->timestampS);
-            if (!options.contactSheet.empty() && frame->index == options.contactFrame)
-                sheet = filter.contactSheet(); // written with the output, when the run is done
-            sink.writeFrame(image, *frame);
-            frameSize = image.size();
-            const FrameReport& done = filter.lastFrame();
-            if (options.explain)
-                std::printf("frame %zu: %s\n", frame->index, done.plan.explain.c_str());
-
-            const Timings& t = done.timings;
-            timingLog.frame(t, frame->index, done.index);
-            for (const auto& pass : t.gpu)
-                passMs[pass.name] += pass.ms;
-            totalMs += t.totalMs;
-            uploadMs += t.uploadMs;
-            readbackMs += t.readbackMs;
-            ++timed;
-            progress.update(framesIn);
+            const bool sheetFrame = !options.contactSheet.empty() && frame->index == options.contactFrame;
+            if (sheetFrame || inFlight == 1) {
+                receiveAll();
+                const cv::Mat image = filter.process(frame->color, frame->depth, frame->timestampS);
+                if (sheetFrame)
+                    sheet = filter.contactSheet(); // written with the output, when the run is done
+                deliver(image, {std::move(*frame), lens.focusM});
+            } else {
+                filter.submit(frame->color, frame->depth, frame->timestampS);
+                waiting.push_back({std::move(*frame), lens.focusM});
+                if (filter.framesInFlight() >= inFlight)
+                    receiveOne();
+            }
         }
+        receiveAll(); // the end of the clip, or a camera stopped: every frame in is a frame out
     } catch (const RequestError&) {
         progress.finish();
         throw;
@@ -445,6 +479,12 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
         if (const auto* background = dynamic_cast<const BackgroundSink*>(&sink))
             if (const std::optional<std::size_t> written = background->failedFrame())
                 current = options.start + *written * options.every; // the k-th frame written, as read
+        // The frames in flight came through before the error: they go with those written before.
+        try {
+            receiveAll();
+        } catch (const std::exception&) {
+            // The sink or the filter fails again: what was written stays as it is.
+        }
         spdlog::error("frame {}: {}", current, error.what());
         status = cli::statusFor(error);
         if (report)
