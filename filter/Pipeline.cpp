@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include <epoxy/gl.h>
+#include <opencv2/imgproc.hpp>
 
 #include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
@@ -267,7 +268,8 @@ Pipeline::~Pipeline() = default;
 void Pipeline::process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality)
 {
     Impl& p = *impl_;
-    CV_Assert(!frame.color.empty() && (frame.color.type() == CV_8UC3 || frame.color.type() == CV_32FC3));
+    CV_Assert(!frame.color.empty() &&
+              (frame.color.type() == CV_8UC3 || frame.color.type() == CV_8UC4 || frame.color.type() == CV_32FC3));
     p.timings = {};
     p.frameStart = Clock::now();
     p.size = frame.color.size();
@@ -323,11 +325,12 @@ void Pipeline::Impl::prepareDepthAndPlan()
     invalidFraction = prepared.invalidFraction;
 
     start = Clock::now();
-    const bool srgbInput = color.type() == CV_8UC3;
+    const bool srgbInput = color.depth() == CV_8U;
     ensureTexture(depth, GL_R32F, size, "filled depth");
     ensureTexture(colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, size, "input colour");
     CV_Assert(color.isContinuous() && prepared.metres.isContinuous());
-    colorTexture.upload(GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT, color.data);
+    // BGRx goes up as it is: the texture has no alpha, so the fourth byte is dropped on the way.
+    colorTexture.upload(color.channels() == 4 ? GL_BGRA : GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT, color.data);
     depth.upload(GL_RED, GL_FLOAT, prepared.metres.data);
     timings.uploadMs = msSince(start);
 
@@ -336,7 +339,7 @@ void Pipeline::Impl::prepareDepthAndPlan()
     // Highlights to treat: the plan's (FramePlan::highlights) on a frame not all in focus, which
     // makePlan() derives from the analysis alone, whatever size it picks.
     const bool lights = analysis.hasHighlights() && !analysis.allInFocus();
-    const bool eightBit = color.type() == CV_8UC3;
+    const bool eightBit = color.depth() == CV_8U;
     const double highlightGain = eightBit && lights ? quality.highlightGain : 1.0;
     // Sprites where a blurred pixel can be brighter than white: float input's highlights, or
     // 8-bit ones scaled up by the gain; and only where such pixels are few, lights rather than
@@ -540,9 +543,9 @@ Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, f
     Impl& p = *this;
     if (!p.rendered)
         p.render();
-    Target& out = encoding == Encoding::Srgb8 ? p.outSrgb : p.outLinear;
-    out.ensure(encoding == Encoding::Srgb8 ? GL_SRGB8_ALPHA8 : GL_RGBA32F, p.size,
-               encoding == Encoding::Srgb8 ? "output sRGB" : "output linear");
+    const bool srgb = encoding != Encoding::Linear32F;
+    Target& out = srgb ? p.outSrgb : p.outLinear;
+    out.ensure(srgb ? GL_SRGB8_ALPHA8 : GL_RGBA32F, p.size, srgb ? "output sRGB" : "output linear");
 
     glBindVertexArray(p.vao.id());
     const bool fused = view == View::Composite && (p.rhombiSecondPending || p.blurShift != 0);
@@ -606,6 +609,42 @@ void Pipeline::Impl::finishTimings(Clock::time_point readStart)
     timings.totalMs = msSince(frameStart);
 }
 
+namespace {
+
+/// A frame all in focus as `encoding` asks: 8-bit input bit-exact (BGRx's fourth byte made 255),
+/// float input from `linear`, its cleaned-up copy.
+cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encoding)
+{
+    if (color.depth() != CV_8U) {
+        if (encoding == Encoding::Linear32F)
+            return linear;
+        cv::Mat srgb = encodeSrgb(linear), bgra;
+        if (encoding == Encoding::Srgb8)
+            return srgb;
+        cv::cvtColor(srgb, bgra, cv::COLOR_BGR2BGRA);
+        return bgra;
+    }
+    cv::Mat out;
+    if (encoding == Encoding::Srgb8Bgra) {
+        if (color.channels() == 3) {
+            cv::cvtColor(color, out, cv::COLOR_BGR2BGRA);
+        } else {
+            out = color.clone();
+            const int toAlpha[] = {0, 3};
+            const cv::Mat opaque(color.size(), CV_8UC1, cv::Scalar(255));
+            cv::mixChannels(&opaque, 1, &out, 1, toAlpha, 1);
+        }
+        return out;
+    }
+    if (color.channels() == 4)
+        cv::cvtColor(color, out, cv::COLOR_BGRA2BGR);
+    else
+        out = color.clone();
+    return encoding == Encoding::Srgb8 ? out : decodeSrgb(out);
+}
+
+} // namespace
+
 struct PendingRead::State {
     cv::Mat ready;              ///< the image, where it needed no read from the GPU
     gl::ReadbackBuffer buffer;  ///< otherwise the read in flight
@@ -649,14 +688,11 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
     if (view == View::Composite && !p.rendered) {
         // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
         // CoC pass's clean-up (no NaN, no negatives, within the target's range).
-        const bool srgbInput = p.color.type() == CV_8UC3;
+        const bool srgbInput = p.color.depth() == CV_8U;
         const cv::Mat linear = srgbInput ? cv::Mat()
                                          : sanitizeLinear(p.color, CocPass::largestColor(
                                                                         p.quality.targetFormat == TargetFormat::Rgba16F));
-        if (encoding == Encoding::Srgb8)
-            read.ready = srgbInput ? p.color.clone() : encodeSrgb(linear);
-        else
-            read.ready = srgbInput ? decodeSrgb(p.color) : linear;
+        read.ready = passThrough(p.color, linear, encoding);
         p.timings.readbackMs = msSince(start);
         p.timings.totalMs = msSince(p.frameStart);
         read.timings = p.timings;
@@ -664,11 +700,13 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
     }
     const Target& out = p.renderOutput(view, encoding, read.low, read.high);
     // Into a buffer of the pool behind a fence: the pixels travel while the caller goes on.
-    const GLsizeiptr bytes = static_cast<GLsizeiptr>(p.size.area()) * 3 *
-                             static_cast<GLsizeiptr>(encoding == Encoding::Srgb8 ? 1 : sizeof(float));
+    const bool bgra = encoding == Encoding::Srgb8Bgra;
+    const GLsizeiptr bytes = static_cast<GLsizeiptr>(p.size.area()) * (bgra ? 4 : 3) *
+                             static_cast<GLsizeiptr>(encoding == Encoding::Linear32F ? sizeof(float) : 1);
     read.buffer = p.takeReadbackBuffer(bytes);
-    read.buffer.readPixels(out.framebuffer.id(), p.size.width, p.size.height, GL_BGR,
-                           encoding == Encoding::Srgb8 ? GL_UNSIGNED_BYTE : GL_FLOAT);
+    // The sRGB target's alpha is 1 wherever the passes write: BGRA reads it as 255.
+    read.buffer.readPixels(out.framebuffer.id(), p.size.width, p.size.height, bgra ? GL_BGRA : GL_BGR,
+                           encoding == Encoding::Linear32F ? GL_FLOAT : GL_UNSIGNED_BYTE);
     p.finishTimings(start);
     read.timings = p.timings;
     return pending;
@@ -681,7 +719,9 @@ cv::Mat Pipeline::collect(PendingRead& pending)
     if (!read.ready.empty())
         return std::exchange(read.ready, cv::Mat());
     const auto start = Clock::now();
-    cv::Mat image(read.size, read.encoding == Encoding::Srgb8 ? CV_8UC3 : CV_32FC3);
+    cv::Mat image(read.size, read.encoding == Encoding::Srgb8       ? CV_8UC3
+                             : read.encoding == Encoding::Srgb8Bgra ? CV_8UC4
+                                                                    : CV_32FC3);
     read.buffer.copyTo(image.data, static_cast<GLsizeiptr>(image.total() * image.elemSize()));
     impl_->spareReadbacks.push_back(std::move(read.buffer));
     if (read.view == View::Depth)

@@ -24,8 +24,9 @@ namespace defocus {
 
 /// How read() returns pixels.
 enum class Encoding {
-    Srgb8,    ///< CV_8UC3 BGR, sRGB-encoded (encoded on the GPU)
-    Linear32F ///< CV_32FC3 BGR, scene-linear, unclipped
+    Srgb8,     ///< CV_8UC3 BGR, sRGB-encoded (encoded on the GPU)
+    Srgb8Bgra, ///< CV_8UC4 BGRA, sRGB-encoded, alpha 255 (GStreamer's BGRx and BGRA)
+    Linear32F  ///< CV_32FC3 BGR, scene-linear, unclipped
 };
 
 struct PassTime {

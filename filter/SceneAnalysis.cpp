@@ -59,7 +59,8 @@ bool SceneAnalysis::tileNeedsBlur(int x, int y, float sharpBelowPx) const
 SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k)
 {
     CV_Assert(filledDepth.type() == CV_32FC1 && filledDepth.size() == color.size() &&
-              (color.type() == CV_8UC3 || color.type() == CV_32FC3));
+              (color.type() == CV_8UC3 || color.type() == CV_8UC4 || color.type() == CV_32FC3));
+    const int channels = color.channels(); // BGR, or BGRx whose fourth byte is not looked at
     SceneMeasurement m;
     constexpr int T = SceneAnalysis::kTileSize;
     m.tiles = {(filledDepth.cols + T - 1) / T, (filledDepth.rows + T - 1) / T};
@@ -121,8 +122,8 @@ SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, 
                     int count = counts[tx];
                     float sum = sums[tx];
                     if (color.depth() == CV_8U) {
-                        const std::uint8_t* p = color.ptr<std::uint8_t>(y) + 3 * x0;
-                        for (int x = x0; x < x1; ++x, p += 3) {
+                        const std::uint8_t* p = color.ptr<std::uint8_t>(y) + channels * x0;
+                        for (int x = x0; x < x1; ++x, p += channels) {
                             count += std::max(p[0], std::max(p[1], p[2])) >= 250 ? 1 : 0;
                             sum += luminanceBgr(decode[p[0]], decode[p[1]], decode[p[2]]);
                         }

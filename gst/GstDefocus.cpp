@@ -775,11 +775,16 @@ cv::Mat toFilter(GstVideoFrame* color)
     }
 }
 
-/// The filter's BGR result into `frame`, in its format; alpha (or x) is opaque.
+/// The filter's result into `frame`, in its format; alpha (or x) is opaque. BGRx and BGRA come
+/// as the filter's BGRA (Settings::Output::Srgb8Bgra) and are copied; the others as BGR.
 void fromFilter(const cv::Mat& bgr, GstVideoFrame* frame)
 {
     // BGRx has three components but four bytes a pixel.
     cv::Mat out = wrap(frame, GST_VIDEO_FRAME_COMP_PSTRIDE(frame, 0) == 4 ? CV_8UC4 : CV_8UC3);
+    if (bgr.type() == CV_8UC4) {
+        bgr.copyTo(out);
+        return;
+    }
     switch (GST_VIDEO_FRAME_FORMAT(frame)) {
     case GST_VIDEO_FORMAT_BGRx:
     case GST_VIDEO_FORMAT_BGRA: cv::cvtColor(bgr, out, cv::COLOR_BGR2BGRA); break;
@@ -921,7 +926,12 @@ GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, 
     State& s = *self->state;
     const GstClockTime pts = GST_BUFFER_PTS(outbuf);
     const FrameSetup setup = setUpFrame(self, pts);
-    const defocus::Settings& settings = setup.settings;
+    defocus::Settings settings = setup.settings;
+    // BGRx and BGRA come back as they go out, four bytes a pixel: no conversion on either side.
+    const GstVideoFormat format = GST_VIDEO_FRAME_FORMAT(color);
+    settings.output = format == GST_VIDEO_FORMAT_BGRx || format == GST_VIDEO_FORMAT_BGRA
+                          ? defocus::Settings::Output::Srgb8Bgra
+                          : defocus::Settings::Output::Srgb8;
     const bool changed = setup.changed, post = setup.post;
     const defocus::gst::LibraryCall call(GST_ELEMENT(self));
 
@@ -930,7 +940,7 @@ GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, 
             // Made here, on the streaming thread, the first time a frame needs it.
             s.filter = std::make_unique<defocus::Filter>(settings);
             GST_INFO_OBJECT(self, "filtering on %s", s.filter->renderer().c_str());
-        } else if (changed) {
+        } else if (changed || s.filter->settings().output != settings.output) {
             s.filter->setSettings(settings);
         }
     } catch (const defocus::GlError& error) {

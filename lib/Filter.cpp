@@ -49,6 +49,16 @@ void checkRange(std::vector<std::string>& issues, const char* parameter, T& valu
         value = std::isnan(static_cast<double>(value)) ? low : std::clamp(value, low, high);
 }
 
+Encoding toEncoding(Settings::Output output)
+{
+    switch (output) {
+    case Settings::Output::Srgb8: return Encoding::Srgb8;
+    case Settings::Output::Linear32F: return Encoding::Linear32F;
+    case Settings::Output::Srgb8Bgra: return Encoding::Srgb8Bgra;
+    }
+    return Encoding::Srgb8;
+}
+
 const char* describeType(const cv::Mat& image)
 {
     switch (image.type()) {
@@ -337,7 +347,9 @@ Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double tim
         // pipeline uploads whole rows, so it gets a copy.
         frame.color = color.isContinuous() ? color : color.clone();
         break;
-    case CV_8UC4: cv::cvtColor(color, frame.color, cv::COLOR_BGRA2BGR); break;
+    case CV_8UC4: // BGRx: uploaded as it is, the fourth byte dropped on the way
+        frame.color = color.isContinuous() ? color : color.clone();
+        break;
     default:
         throw InputError(fmt::format("colour image is {}; expected BGR 8-bit (CV_8UC3, or CV_8UC4 whose fourth "
                                      "channel is ignored) or float (CV_32FC3)",
@@ -397,8 +409,7 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     Frame frame = p.admit(color, depth, timestampS, lens);
 
     const auto bound = p.current();
-    const Encoding encoding =
-        p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
+    const Encoding encoding = toEncoding(p.settings.output);
     cv::Mat out;
     if (p.textureFrame) { // processTextures(): the result stays on the GPU
         p.pipeline->process(frame, lens, p.quality);
@@ -469,8 +480,7 @@ void Filter::submit(const cv::Mat& color, const cv::Mat& depth, double timestamp
     LensSettings lens;
     Frame frame = p.admit(color, depth, timestampS, lens);
     const auto bound = p.current();
-    const Encoding encoding =
-        p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
+    const Encoding encoding = toEncoding(p.settings.output);
     p.pipeline->process(frame, lens, p.quality);
     Impl::InFlight entry{p.pipeline->readAsync(toView(p.settings.view), encoding), {}};
     p.lastFrame = std::move(frame);
@@ -516,8 +526,7 @@ cv::Mat Filter::contactSheet()
                        drawTileMap(tiles.front().second, pipeline.plan(), pipeline.analysis()));
     cv::Mat sheet = defocus::contactSheet(tiles);
     // Processed again so that the timings are a plain frame's, not the views' reads.
-    const Encoding encoding =
-        p.settings.output == Settings::Output::Linear32F ? Encoding::Linear32F : Encoding::Srgb8;
+    const Encoding encoding = toEncoding(p.settings.output);
     pipeline.run(*p.lastFrame, p.lastLens, p.quality, toView(p.settings.view), encoding);
     p.fillReport(p.frames - 1);
     return sheet;

@@ -549,3 +549,35 @@ TEST(LibraryInFlight, FramesInFlightAreTheFramesOneAtATime)
             EXPECT_FALSE(pipelined->receive());
         }
 }
+
+// Defect caught: BGRx in or BGRA out that is not the BGR frame's result (channels swapped, the
+// fourth input byte reaching the picture, an alpha that is not opaque), blurred or all in focus.
+TEST_F(Library, BgrxInAndBgraOutAreTheBgrFramesResult)
+{
+    cv::Mat bgrx;
+    cv::cvtColor(color_, bgrx, cv::COLOR_BGR2BGRA);
+    cv::Mat noise(color_.size(), CV_8UC1);
+    cv::randu(noise, 0, 256);
+    const int toX[] = {0, 3};
+    cv::mixChannels(&noise, 1, &bgrx, 1, toX, 1); // the x byte is anything
+    cv::Mat flat(depth_.size(), CV_16UC1, cv::Scalar(settings_.depthScale * settings_.lens.focusM));
+    for (const cv::Mat& depth : {depth_, flat}) {
+        const bool inFocus = depth.data == flat.data;
+        const cv::Mat expected = filter_->process(color_, depth);
+        ASSERT_EQ(filter_->lastFrame().plan.allInFocus, inFocus);
+        EXPECT_TRUE(identical(filter_->process(bgrx, depth), expected)) << "BGRx in, BGR out; in focus " << inFocus;
+        defocus::Settings bgra = settings_;
+        bgra.output = defocus::Settings::Output::Srgb8Bgra;
+        filter_->setSettings(bgra);
+        for (const cv::Mat& input : {color_, bgrx}) {
+            const cv::Mat out = filter_->process(input, depth);
+            ASSERT_EQ(out.type(), CV_8UC4);
+            cv::Mat bgr, alpha;
+            cv::cvtColor(out, bgr, cv::COLOR_BGRA2BGR);
+            cv::extractChannel(out, alpha, 3);
+            EXPECT_TRUE(identical(bgr, expected)) << input.channels() << " channels in, BGRA out; in focus " << inFocus;
+            EXPECT_EQ(cv::countNonZero(alpha != 255), 0) << "alpha not opaque; in focus " << inFocus;
+        }
+        filter_->setSettings(settings_);
+    }
+}

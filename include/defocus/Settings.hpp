@@ -116,8 +116,9 @@ struct Settings {
     enum class View { Input, Horizontal, DiagonalA, DiagonalB, Composite, Depth, Coc };
     /// How the result is returned.
     enum class Output {
-        Srgb8,    ///< CV_8UC3 BGR, sRGB-encoded (what an 8-bit image or video holds)
-        Linear32F ///< CV_32FC3 BGR, scene-linear, unclipped (HDR kept)
+        Srgb8,     ///< CV_8UC3 BGR, sRGB-encoded (what an 8-bit image or video holds)
+        Linear32F, ///< CV_32FC3 BGR, scene-linear, unclipped (HDR kept)
+        Srgb8Bgra  ///< CV_8UC4 BGRA, sRGB-encoded, alpha 255 (GStreamer's BGRx and BGRA, no conversion)
     };
 
     Lens lens;
