@@ -11,7 +11,6 @@
 #include <fstream>
 #include <optional>
 #include <stdexcept>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -615,24 +614,15 @@ CLI::App* declareThroughput(CLI::App& app, defocus::ThroughputOptions& o)
                                                      "time and with frames in flight, interleaved in one run, and "
                                                      "the calling thread's CPU time per frame");
     sub->add_option("--data", o.data, "TUM RGB-D folder to take frames from")->capture_default_str();
-    sub->add_option_function<std::string>(
+    sub->add_option_function<std::vector<std::string>>(
            "--sizes",
-           [&o](const std::string& text) {
+           [&o](const std::vector<std::string>& texts) {
                o.sizes.clear();
-               std::size_t start = 0;
-               while (start <= text.size()) {
-                   const std::size_t comma = std::min(text.find(',', start), text.size());
-                   int width = 0, height = 0;
-                   char x = 0;
-                   std::istringstream in(text.substr(start, comma - start));
-                   if (!(in >> width >> x >> height) || x != 'x' || width < 16 || height < 16 || width > 8192 ||
-                       height > 8192)
-                       throw CLI::ValidationError("--sizes", "'" + text + "' is not WxH,WxH... (16 to 8192 pixels)");
-                   o.sizes.emplace_back(width, height);
-                   start = comma + 1;
-               }
+               for (const std::string& text : texts)
+                   o.sizes.push_back(parseSize(text));
            },
            "Frame sizes, WxH comma-separated")
+        ->delimiter(',')
         ->default_str("640x480,1920x1080");
     sub->add_option("--quality", o.preset, "Preset: fast, balanced or high")
         ->check(CLI::IsMember({"fast", "balanced", "high"}))

@@ -21,6 +21,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "tests/ImageCompare.hpp"
 #include "tests/TestSupport.hpp"
 
 namespace {
@@ -45,16 +46,7 @@ Pair bundled(int line)
     return {dir / rgb, dir / depth};
 }
 
-::testing::AssertionResult identical(const cv::Mat& a, const cv::Mat& b)
-{
-    if (a.size() != b.size() || a.type() != b.type())
-        return ::testing::AssertionFailure() << "sizes or types differ";
-    cv::Mat diff;
-    cv::absdiff(a, b, diff);
-    const int differing = cv::countNonZero(diff.reshape(1));
-    return differing == 0 ? ::testing::AssertionSuccess()
-                          : ::testing::AssertionFailure() << differing << " samples differ";
-}
+using defocus::test::identical;
 
 class Library : public ::testing::Test {
 protected:

@@ -15,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "tests/ImageCompare.hpp"
 #include "tests/TestSupport.hpp"
 
 namespace {
@@ -219,16 +220,7 @@ protected:
     cv::Mat color_, depth_;
 };
 
-::testing::AssertionResult identical(const cv::Mat& a, const cv::Mat& b)
-{
-    if (a.size() != b.size() || a.type() != b.type())
-        return ::testing::AssertionFailure() << "sizes or types differ";
-    cv::Mat diff;
-    cv::absdiff(a, b, diff);
-    const int differing = cv::countNonZero(diff.reshape(1));
-    return differing == 0 ? ::testing::AssertionSuccess()
-                          : ::testing::AssertionFailure() << differing << " samples differ";
-}
+using defocus::test::identical;
 
 // Defects caught: red and blue swapped on the way in or out (the BGRA order GStreamer uses), the
 // GRAY16_LE bytes read high byte first, R32F depth scaled as units, the output copy decoding

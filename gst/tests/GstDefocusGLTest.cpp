@@ -28,6 +28,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "tests/ImageCompare.hpp"
+
 namespace {
 
 constexpr GstClockTime kFrame = GST_SECOND / 30;
@@ -79,19 +81,7 @@ std::string caps(const char* format, cv::Size size)
 }
 
 /// Success when `a` and `b` are the same image, byte for byte; else how they differ.
-::testing::AssertionResult identical(const cv::Mat& a, const cv::Mat& b)
-{
-    if (a.size() != b.size() || a.type() != b.type())
-        return ::testing::AssertionFailure() << "sizes or types differ";
-    cv::Mat diff;
-    cv::absdiff(a, b, diff);
-    const int differing = cv::countNonZero(diff.reshape(1));
-    if (differing == 0)
-        return ::testing::AssertionSuccess();
-    double largest = 0;
-    cv::minMaxLoc(diff.reshape(1), nullptr, &largest);
-    return ::testing::AssertionFailure() << differing << " samples differ, by up to " << largest;
-}
+using defocus::test::identical;
 
 /// The element with two harnesses: `color` also pulls from src.
 struct Element {
