@@ -5,10 +5,11 @@
 #   scripts/setup.sh [--tests | --all] [BUILD_DIR]   (default: build)
 #     (no option)  what building defocus and scripts/demo.sh need
 #     --tests      and what the default test tier needs (scripts/test.sh): GStreamer's tools and
-#                  plugins for the element's tests, GNU parallel for the batch test
+#                  plugins for the element's tests (its GL library's elements, and Xvfb for its
+#                  GL memory under an X display), GNU parallel for the batch test
 #     --all        and what every tier needs (scripts/test.sh --all): Slurm and munge for the
 #                  one-node cluster test, and the plugins of the README's GStreamer pipelines.
-#                  The VM, window and container tests install their own (qemu, Xvfb, podman).
+#                  The VM and container tests install their own (qemu, podman).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 tier=build
