@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
+# The GPU figures of docs/benchmarks.md in one command on a machine with an NVIDIA GPU and none
+# of the project's packages (such as the lent H100/H200), from a bundle packed here.
+#   scripts/gpu-figures.sh pack [BUILD_DIR]   here: defocus and defocus-bench with the libraries
+#                                             they load into .gpu/ (ignored by git: carry it)
+#   scripts/gpu-figures.sh run [OUT_DIR]      there, from a copy of the repository root: the GPU
+#                                             and driver, frames in flight against one at a time,
+#                                             and the per-pass table, into OUT_DIR ($OUT or out/gpu);
+#                                             about 3 minutes on an H100 (the sizes 640x480 to 4K)
+# pack needs the bundler of ../shared/tools/gpu (or DEFOCUS_GPU_TOOLS=DIR): it is the project's
+# tool for that machine, not part of the build. run prints each step's command before its output.
+# Exit: 0 done, 1 a step failed (the files so far are kept), 2 usage.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+case ${1:-} in
+  pack)
+    build=${2:-build}
+    tools=${DEFOCUS_GPU_TOOLS:-$root/../shared/tools/gpu}
+    if [[ ! -f $tools/bundle.py ]]; then
+      echo "gpu-figures: error: no bundler at $tools/bundle.py (set DEFOCUS_GPU_TOOLS)" >&2; exit 1
+    fi
+    for program in defocus defocus-bench; do
+      [[ -x $build/$program ]] || { echo "gpu-figures: error: $build/$program is not built" >&2; exit 1; }
+    done
+    staging=$(mktemp -d)
+    trap 'rm -rf "$staging"' EXIT
+    python3 "$tools/bundle.py" "$build" "$staging/bundle" defocus defocus-bench
+    mkdir -p .gpu
+    tar -C "$staging/bundle" -cJf .gpu/bundle.tar.xz bin lib
+    cp "$tools/env.sh" .gpu/env.sh
+    git rev-parse --short HEAD > .gpu/commit 2>/dev/null || echo unknown > .gpu/commit
+    echo "gpu-figures: .gpu/ packed ($(du -h .gpu/bundle.tar.xz | cut -f1)) from $(cat .gpu/commit); run there:" \
+         "scripts/gpu-figures.sh run, carrying .gpu"
+    ;;
+  run)
+    out=${2:-${OUT:-out/gpu}}
+    # Smaller for a try on llvmpipe: DEFOCUS_GPU_SIZES=320x240 DEFOCUS_GPU_FRAMES=6
+    sizes=${DEFOCUS_GPU_SIZES:-640x480,1920x1080,3840x2160}
+    frames=${DEFOCUS_GPU_FRAMES:-40}
+    [[ -f .gpu/bundle.tar.xz ]] || { echo "gpu-figures: error: no .gpu/bundle.tar.xz (pack it first)" >&2; exit 1; }
+    mkdir -p "$out"
+    unpacked=$(mktemp -d)
+    tar -C "$unpacked" -xJf .gpu/bundle.tar.xz
+    # NVIDIA's EGL and the bundle's libraries (env.sh's probes may fail where a path is absent).
+    set +eu +o pipefail
+    # shellcheck disable=SC1091
+    . .gpu/env.sh "$unpacked"
+    set -euo pipefail
+    step() {
+      local name=$1; shift
+      echo "\$ $*" | tee "$out/$name.txt"
+      "$@" 2>&1 | tee -a "$out/$name.txt"
+    }
+    { date -u +%FT%TZ; cat .gpu/commit; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null || true; } \
+      | tee "$out/machine.txt"
+    step info "$unpacked/bin/defocus" --info
+    step throughput "$unpacked/bin/defocus-bench" throughput --sizes "$sizes" --frames "$frames" --passes 3
+    step passes "$unpacked/bin/defocus-bench" --sizes "$sizes" --runs "$frames" --warmup 5 --json "$out/bench.json"
+    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json"
+    ;;
+  *)
+    echo "usage: scripts/gpu-figures.sh pack [BUILD_DIR] | run [OUT_DIR]" >&2
+    exit 2
+    ;;
+esac
