@@ -7,7 +7,7 @@
 #   scripts/gpu-figures.sh run [OUT_DIR]      there, from a copy of the repository root: the GPU
 #                                             and driver, frames in flight against one at a time,
 #                                             and the per-pass table, into OUT_DIR ($OUT or out/gpu);
-#                                             about 3 minutes on an H100 (the sizes 640x480 to 4K)
+#                                             40 frames per size (640x480 to 4K) and way, 3 passes
 # pack needs the bundler of ../shared/tools/gpu (or DEFOCUS_GPU_TOOLS=DIR): it is the project's
 # tool for that machine, not part of the build. run prints each step's command before its output.
 # Exit: 0 done, 1 a step failed (the files so far are kept), 2 usage.
