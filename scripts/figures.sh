@@ -33,6 +33,7 @@ sections=(
   "synthetic|one frame of the synthetic thin-lens truth (README Synthetic truth)|$build/defocus-synthetic --scene spheres --focal-length 85 --f-number 1.4 --focus 5 -y -o $out/synthetic"
   "soak|10,000 frames: memory and GL objects (README Stability)|$build/defocus-soak --frames 10000"
   "gst-gl|the defocus element's frames per second in system and in GL memory, 640x480, no display (docs/gstreamer.md)|env -u DISPLAY -u WAYLAND_DISPLAY scripts/gst-gl-fps.sh $build 200"
+  "gst-gl-1080|the same at 1920x1080 (docs/gstreamer.md)|env -u DISPLAY -u WAYLAND_DISPLAY scripts/gst-gl-fps.sh $build 30 1920x1080"
 )
 
 field() { cut -d'|' -f"$2" <<<"$1"; }
