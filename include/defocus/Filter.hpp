@@ -182,7 +182,8 @@ public:
 
     /// Filters one frame and returns the result, the colour's size (Settings::output says
     /// how it is encoded).
-    /// `color`: BGR, CV_8UC3 sRGB-encoded (CV_8UC4: the fourth channel is ignored) or CV_32FC3
+    /// `color`: BGR, CV_8UC3 sRGB-encoded (CV_8UC4: BGRx, uploaded as it is, the fourth channel
+    /// ignored; Settings::Output::Srgb8Bgra returns the same four bytes a pixel) or CV_32FC3
     /// scene-linear. `depth`: along the view axis, CV_16UC1 in Settings::depthScale units per
     /// metre or CV_32FC1 metres; 0, NaN and infinities mean "no measurement" (filled from valid
     /// neighbours); any size with the colour's aspect ratio (resized by nearest neighbour); empty
