@@ -3,6 +3,7 @@
 #include "filter/DepthPrep.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -85,21 +86,27 @@ void prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM, DepthPre
 
     ws.weight.create(size, CV_32F);
     ws.holes.create(size, CV_8U);
-    std::size_t invalid = 0;
-    for (int y = 0; y < resized.rows; ++y) {
-        auto* z = resized.ptr<float>(y);
-        auto* w = ws.weight.ptr<float>(y);
-        auto* hole = ws.holes.ptr<std::uint8_t>(y);
-        for (int x = 0; x < resized.cols; ++x) {
-            const bool valid = isValidDepth(z[x]);
-            w[x] = valid ? 1.0f : 0.0f;
-            hole[x] = valid ? 0 : 255;
-            if (!valid) {
-                z[x] = 0.0f;
-                ++invalid;
+    // Rows in bands on OpenCV's threads: each pixel on its own, the count summed at the end.
+    std::atomic<std::size_t> invalidPixels{0};
+    cv::parallel_for_(cv::Range(0, resized.rows), [&](const cv::Range& range) {
+        std::size_t band = 0;
+        for (int y = range.start; y < range.end; ++y) {
+            auto* z = resized.ptr<float>(y);
+            auto* w = ws.weight.ptr<float>(y);
+            auto* hole = ws.holes.ptr<std::uint8_t>(y);
+            for (int x = 0; x < resized.cols; ++x) {
+                const bool valid = isValidDepth(z[x]);
+                w[x] = valid ? 1.0f : 0.0f;
+                hole[x] = valid ? 0 : 255;
+                if (!valid) {
+                    z[x] = 0.0f;
+                    ++band;
+                }
             }
         }
-    }
+        invalidPixels += band;
+    });
+    const std::size_t invalid = invalidPixels.load();
     out.invalidFraction = static_cast<double>(invalid) / static_cast<double>(size.area());
     if (invalid == static_cast<std::size_t>(size.area())) {
         resized.setTo(fallbackM);
