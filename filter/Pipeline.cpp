@@ -6,6 +6,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 
 #include <epoxy/gl.h>
 #include <opencv2/imgproc.hpp>
@@ -85,18 +86,28 @@ void ensureTexture(gl::Texture& texture, GLenum format, cv::Size size, const cha
 /// Returns the share of `depth` that is no measurement (1 when it is empty).
 double validDepthRange(const cv::Mat& depth, float& lo, float& hi)
 {
+    // Rows in bands on OpenCV's threads; a minimum, a maximum and a count combine in any order.
     float low = std::numeric_limits<float>::max(), high = std::numeric_limits<float>::lowest();
     std::size_t invalid = 0;
-    for (int y = 0; y < depth.rows; ++y) {
-        const float* z = depth.ptr<float>(y);
-        for (int x = 0; x < depth.cols; ++x)
-            if (isValidDepth(z[x])) {
-                low = std::min(low, z[x]);
-                high = std::max(high, z[x]);
-            } else {
-                ++invalid;
-            }
-    }
+    std::mutex combine;
+    cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& range) {
+        float bandLow = std::numeric_limits<float>::max(), bandHigh = std::numeric_limits<float>::lowest();
+        std::size_t bandInvalid = 0;
+        for (int y = range.start; y < range.end; ++y) {
+            const float* z = depth.ptr<float>(y);
+            for (int x = 0; x < depth.cols; ++x)
+                if (isValidDepth(z[x])) {
+                    bandLow = std::min(bandLow, z[x]);
+                    bandHigh = std::max(bandHigh, z[x]);
+                } else {
+                    ++bandInvalid;
+                }
+        }
+        const std::lock_guard lock(combine);
+        low = std::min(low, bandLow);
+        high = std::max(high, bandHigh);
+        invalid += bandInvalid;
+    });
     if (low <= high) {
         lo = low;
         hi = high;
