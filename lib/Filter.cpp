@@ -190,7 +190,6 @@ std::string version()
 struct Filter::Impl {
     std::optional<gl::EglContext> context; ///< none: the caller's (ContextOptions::callerContext)
     RendererInfo callerInfo;               ///< the caller's context, where it renders on that
-    const GlFrame* textureFrame = nullptr; ///< processTextures()' frame, during that call
     std::optional<Pipeline> pipeline; ///< destroyed first, with the context current
     Settings settings;
     LensSettings lens;
@@ -219,6 +218,10 @@ struct Filter::Impl {
     /// The frame process() and submit() filter from the caller's images, and its lens (the
     /// autofocus stepped); throws InputError and SettingsError as process() documents.
     Frame admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens);
+    /// submit() without its check: the frame's passes run, its read queued into inFlight.
+    void submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
+    /// receive() of a frame in flight (there must be one).
+    cv::Mat receiveFrame();
 
     /// The context current on the calling thread until the end of the call, whichever thread
     /// used the Filter before; then what was current there before is again. On the caller's
@@ -342,12 +345,10 @@ Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double tim
     Frame frame;
     switch (color.type()) {
     case CV_8UC3:
+    case CV_8UC4: // BGRx: uploaded as it is, the fourth byte dropped on the way
     case CV_32FC3:
         // A view into a larger image (a cv::Rect of it) has gaps between its rows: the
         // pipeline uploads whole rows, so it gets a copy.
-        frame.color = color.isContinuous() ? color : color.clone();
-        break;
-    case CV_8UC4: // BGRx: uploaded as it is, the fourth byte dropped on the way
         frame.color = color.isContinuous() ? color : color.clone();
         break;
     default:
@@ -405,23 +406,8 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
     if (!p.inFlight.empty())
         throw Error(fmt::format("defocus::Filter::process(): {} frames in flight; receive() them first",
                                 p.inFlight.size()));
-    LensSettings lens;
-    Frame frame = p.admit(color, depth, timestampS, lens);
-
-    const auto bound = p.current();
-    const Encoding encoding = toEncoding(p.settings.output);
-    cv::Mat out;
-    if (p.textureFrame) { // processTextures(): the result stays on the GPU
-        p.pipeline->process(frame, lens, p.quality);
-        p.pipeline->readInto(toView(p.settings.view), p.textureFrame->output,
-                             p.textureFrame->outputOrder == GlFrame::Order::Bgra);
-    } else {
-        out = p.pipeline->run(frame, lens, p.quality, toView(p.settings.view), encoding);
-    }
-    p.lastFrame = std::move(frame);
-    p.lastLens = lens;
-    p.fillReport(p.frames++);
-    return out;
+    p.submitFrame(color, depth, timestampS);
+    return p.receiveFrame();
 }
 
 void Filter::Impl::fillReport(std::size_t index, const FrameTimings& t, FrameReport& r) const
@@ -472,36 +458,43 @@ std::vector<Timings::Pass> Filter::finishGpuTimings()
     return out;
 }
 
+void Filter::Impl::submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+{
+    LensSettings frameLens;
+    Frame frame = admit(color, depth, timestampS, frameLens);
+    const auto bound = current();
+    pipeline->process(frame, frameLens, quality);
+    InFlight entry{pipeline->readAsync(toView(settings.view), toEncoding(settings.output)), {}};
+    lastFrame = std::move(frame);
+    lastLens = frameLens;
+    fillReport(frames++, entry.read.timings(), entry.report);
+    inFlight.push_back(std::move(entry));
+}
+
+cv::Mat Filter::Impl::receiveFrame()
+{
+    const auto bound = current();
+    InFlight& oldest = inFlight.front();
+    cv::Mat image = pipeline->collect(oldest.read);
+    report = std::move(oldest.report);
+    report.timings.readbackMs = oldest.read.timings().readbackMs;
+    report.timings.totalMs = oldest.read.timings().totalMs;
+    inFlight.pop_front();
+    return image;
+}
+
 void Filter::submit(const cv::Mat& color, const cv::Mat& depth, double timestampS)
 {
-    Impl& p = *impl_;
-    if (p.textureFrame || !p.context)
+    if (!impl_->context)
         throw Error("defocus::Filter::submit(): frames in GL textures go through processTextures()");
-    LensSettings lens;
-    Frame frame = p.admit(color, depth, timestampS, lens);
-    const auto bound = p.current();
-    const Encoding encoding = toEncoding(p.settings.output);
-    p.pipeline->process(frame, lens, p.quality);
-    Impl::InFlight entry{p.pipeline->readAsync(toView(p.settings.view), encoding), {}};
-    p.lastFrame = std::move(frame);
-    p.lastLens = lens;
-    p.fillReport(p.frames++, entry.read.timings(), entry.report);
-    p.inFlight.push_back(std::move(entry));
+    impl_->submitFrame(color, depth, timestampS);
 }
 
 std::optional<cv::Mat> Filter::receive()
 {
-    Impl& p = *impl_;
-    if (p.inFlight.empty())
+    if (impl_->inFlight.empty())
         return std::nullopt;
-    const auto bound = p.current();
-    Impl::InFlight& oldest = p.inFlight.front();
-    cv::Mat image = p.pipeline->collect(oldest.read);
-    p.report = std::move(oldest.report);
-    p.report.timings.readbackMs = oldest.read.timings().readbackMs;
-    p.report.timings.totalMs = oldest.read.timings().totalMs;
-    p.inFlight.pop_front();
-    return image;
+    return impl_->receiveFrame();
 }
 
 std::size_t Filter::framesInFlight() const
@@ -592,14 +585,14 @@ void Filter::processTextures(const GlFrame& frame, double timestampS)
     } catch (const gl::ContextError& error) {
         throw InputError(error.what());
     }
-    p.textureFrame = &frame;
-    try {
-        process(color, depth, timestampS);
-    } catch (...) {
-        p.textureFrame = nullptr;
-        throw;
-    }
-    p.textureFrame = nullptr;
+    LensSettings lens;
+    Frame admitted = p.admit(color, depth, timestampS, lens);
+    // The result stays on the GPU, in the caller's texture.
+    p.pipeline->process(admitted, lens, p.quality);
+    p.pipeline->readInto(toView(p.settings.view), frame.output, frame.outputOrder == GlFrame::Order::Bgra);
+    p.lastFrame = std::move(admitted);
+    p.lastLens = lens;
+    p.fillReport(p.frames++);
 }
 
 } // namespace defocus
