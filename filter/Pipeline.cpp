@@ -622,6 +622,17 @@ void Pipeline::Impl::finishTimings(Clock::time_point readStart)
 
 namespace {
 
+/// The image type read() returns for `encoding`.
+int imageType(Encoding encoding)
+{
+    switch (encoding) {
+    case Encoding::Srgb8: return CV_8UC3;
+    case Encoding::Srgb8Bgra: return CV_8UC4;
+    case Encoding::Linear32F: return CV_32FC3;
+    }
+    return CV_8UC3;
+}
+
 /// A frame all in focus as `encoding` asks: 8-bit input bit-exact (BGRx's fourth byte made 255),
 /// float input from `linear`, its cleaned-up copy.
 cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encoding)
@@ -711,13 +722,11 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
     }
     const Target& out = p.renderOutput(view, encoding, read.low, read.high);
     // Into a buffer of the pool behind a fence: the pixels travel while the caller goes on.
-    const bool bgra = encoding == Encoding::Srgb8Bgra;
-    const GLsizeiptr bytes = static_cast<GLsizeiptr>(p.size.area()) * (bgra ? 4 : 3) *
-                             static_cast<GLsizeiptr>(encoding == Encoding::Linear32F ? sizeof(float) : 1);
-    read.buffer = p.takeReadbackBuffer(bytes);
+    const int type = imageType(encoding);
+    read.buffer = p.takeReadbackBuffer(static_cast<GLsizeiptr>(p.size.area()) * CV_ELEM_SIZE(type));
     // The sRGB target's alpha is 1 wherever the passes write: BGRA reads it as 255.
-    read.buffer.readPixels(out.framebuffer.id(), p.size.width, p.size.height, bgra ? GL_BGRA : GL_BGR,
-                           encoding == Encoding::Linear32F ? GL_FLOAT : GL_UNSIGNED_BYTE);
+    read.buffer.readPixels(out.framebuffer.id(), p.size.width, p.size.height, CV_MAT_CN(type) == 4 ? GL_BGRA : GL_BGR,
+                           CV_MAT_DEPTH(type) == CV_32F ? GL_FLOAT : GL_UNSIGNED_BYTE);
     p.finishTimings(start);
     read.timings = p.timings;
     return pending;
@@ -730,9 +739,7 @@ cv::Mat Pipeline::collect(PendingRead& pending)
     if (!read.ready.empty())
         return std::exchange(read.ready, cv::Mat());
     const auto start = Clock::now();
-    cv::Mat image(read.size, read.encoding == Encoding::Srgb8       ? CV_8UC3
-                             : read.encoding == Encoding::Srgb8Bgra ? CV_8UC4
-                                                                    : CV_32FC3);
+    cv::Mat image(read.size, imageType(read.encoding));
     read.buffer.copyTo(image.data, static_cast<GLsizeiptr>(image.total() * image.elemSize()));
     impl_->spareReadbacks.push_back(std::move(read.buffer));
     if (read.view == View::Depth)
