@@ -380,7 +380,6 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
         double focusM = 0.0;
     };
     std::deque<Waiting> waiting; // submitted, in order
-    std::size_t delivered = 0;
     // A frame back from the filter: to the sink, the explanation, the timings, the progress.
     const auto deliver = [&](const cv::Mat& image, const Waiting& w) {
         if (options.explain)
@@ -397,8 +396,7 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
         totalMs += t.totalMs;
         uploadMs += t.uploadMs;
         readbackMs += t.readbackMs;
-        ++timed;
-        progress.update(++delivered);
+        progress.update(++timed);
     };
     const auto receiveOne = [&] {
         const std::optional<cv::Mat> image = filter.receive();
