@@ -12,6 +12,7 @@
 
 #include "defocus/Filter.hpp"
 #include "defocus/Source.hpp"
+#include "samples/BenchMachine.hpp"
 #include "samples/ExitStatus.hpp"
 
 namespace defocus {
@@ -24,17 +25,6 @@ double threadCpuMs()
     timespec t{};
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
     return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
-
-struct Pass {
-    double wallMs = 0.0; ///< per frame
-    double cpuMs = 0.0;  ///< calling thread, per frame
-};
-
-double median(std::vector<double> values)
-{
-    std::sort(values.begin(), values.end());
-    return values.empty() ? 0.0 : values[values.size() / 2];
 }
 
 } // namespace
