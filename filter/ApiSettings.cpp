@@ -51,7 +51,9 @@ LensSettings toLens(const Lens& lens)
     out.sensorWidthMm = lens.sensorWidthMm;
     out.fieldOfView = lens.fovFrom == Lens::FovFrom::FocalLength ? FieldOfView::FocalLength : FieldOfView::ImageDistance;
     out.maxCocPx = lens.maxCocPx;
+    out.blades = lens.blades;
     out.bladeRotationDeg = lens.bladeRotationDeg;
+    out.apertureRatio = lens.apertureRatio;
     out.nearLimitM = lens.nearM;
     out.farLimitM = lens.farM;
     return out;
@@ -64,7 +66,9 @@ void fromLens(const LensSettings& in, Lens& lens)
     lens.focusM = in.focusM;
     lens.sensorWidthMm = in.sensorWidthMm;
     lens.maxCocPx = in.maxCocPx;
+    lens.blades = in.blades;
     lens.bladeRotationDeg = in.bladeRotationDeg;
+    lens.apertureRatio = in.apertureRatio;
     lens.nearM = in.nearLimitM;
     lens.farM = in.farLimitM;
 }

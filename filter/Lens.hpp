@@ -26,6 +26,17 @@ struct CocCoefficients {
 /// `lens` must have passed validate().
 CocCoefficients cocCoefficients(const LensSettings& lens, int imageWidthPx);
 
+/// `k` with every CoC it gives (and its clamp) multiplied by `scale`.
+inline CocCoefficients scaled(CocCoefficients k, float scale)
+{
+    k.nearScale *= scale;
+    k.nearOffset *= scale;
+    k.farScale *= scale;
+    k.farOffset *= scale;
+    k.maxCocPx *= scale;
+    return k;
+}
+
 /// Evaluates the model exactly as the shader does (for tests and CPU tools; inline, for the
 /// scene analysis' per-pixel loop).
 inline float cocPixels(const CocCoefficients& k, float depthM)

@@ -11,6 +11,7 @@
 #include <epoxy/gl.h>
 #include <opencv2/imgproc.hpp>
 
+#include "filter/Aperture.hpp"
 #include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
@@ -175,9 +176,12 @@ struct Pipeline::Impl {
     // The last frame, kept until its passes have run (they are skipped when all is in focus
     // and the composite is all that is read).
     cv::Mat color;
+    /// The gather's CoC: the lens', scaled so that the rhombi's hexagon covers the aperture's
+    /// area (gatherScale(); 1 for the hexagon). The sprites draw the aperture itself.
     CocCoefficients coefficients;
     QualitySettings quality;
-    float bladeRotationDeg = 0.0f;
+    float bladeRotationDeg = 0.0f; ///< the gather's hexagon's
+    ApertureShape aperture;
     SceneAnalysis analysis;
     FramePlan plan;
     bool rendered = false;
@@ -290,9 +294,13 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     p.color = frame.color;
     p.depthInput = frame.depth;
     p.quality = quality;
-    p.bladeRotationDeg = static_cast<float>(lens.bladeRotationDeg);
-    p.coefficients = cocCoefficients(lens, p.size.width);
-    p.maxCocPx = p.coefficients.maxCocPx;
+    p.aperture = ApertureShape::of(lens);
+    // The gather's hexagon: the lens' for a hexagonal aperture; for other shapes a corner on top,
+    // whose lines lie on the axes (a rotated hexagon's off-axis lines cost llvmpipe 8x as much).
+    p.bladeRotationDeg = p.aperture.isHexagon() ? static_cast<float>(lens.bladeRotationDeg) : 0.0f;
+    const CocCoefficients lensCoc = cocCoefficients(lens, p.size.width);
+    p.coefficients = scaled(lensCoc, gatherScale(p.aperture));
+    p.maxCocPx = lensCoc.maxCocPx;
     p.frameIndex = frame.index;
     p.fallbackDepth = std::isinf(lens.focusM) ? 1e6f : static_cast<float>(lens.focusM);
     p.rendered = false;
@@ -526,7 +534,7 @@ void Pipeline::Impl::render()
             neighbourhoods = gl::StorageBuffer(bytes, "tile neighbourhoods");
         neighbourhoods.update(analysis.tileNeighbourhood.data, bytes);
         highlightSpritePass.find(colorTexture, depth, coefficients, static_cast<float>(plan.highlightGain),
-                                 CocPass::largestColor(half), bladeRotationDeg, plan.nearField,
+                                 CocPass::largestColor(half), aperture, plan.nearField,
                                  neighbourhoods, analysis.highlightTiles,
                                  HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
                                                              analysis.highlightPixels));
@@ -582,8 +590,9 @@ Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, f
             high = static_cast<float>(std::max(hi, lo * 1.01 + 1e-3));
             p.viewPass.run(p.depth, ViewPass::Mode::Depth, low, high, out.framebuffer);
         } else if (view == View::Coc) {
-            high = p.maxCocPx / static_cast<float>(1 << p.blurShift); // the target's pixels
-            p.viewPass.run(p.coc.texture, ViewPass::Mode::Coc, 0.0f, high, out.framebuffer);
+            // The lens' CoC in the target's pixels; the target holds the gather's.
+            high = p.maxCocPx / static_cast<float>(1 << p.blurShift);
+            p.viewPass.run(p.coc.texture, ViewPass::Mode::Coc, 0.0f, high * gatherScale(p.aperture), out.framebuffer);
         } else {
             p.viewPass.run(p.target(view).texture, ViewPass::Mode::Color, 0.0f, 0.0f, out.framebuffer);
         }

@@ -60,6 +60,14 @@ std::vector<SettingIssue> validate(LensSettings& lens, bool clamp)
     checkRange(issues, "--max-coc", lens.maxCocPx, limits::kMaxCocPx[0], limits::kMaxCocPx[1], clamp);
     checkRange(issues, "--blade-rotation", lens.bladeRotationDeg, limits::kBladeRotationDeg[0],
                limits::kBladeRotationDeg[1], clamp);
+    checkRange(issues, "--aperture-ratio", lens.apertureRatio, limits::kApertureRatio[0], limits::kApertureRatio[1],
+               clamp);
+    if (lens.blades != 0 && (lens.blades < limits::kBlades[0] || lens.blades > limits::kBlades[1])) {
+        issues.push_back({"--blades", fmt::format("--blades must be 0 (circular) or between {} and {}, not {}",
+                                                  limits::kBlades[0], limits::kBlades[1], lens.blades)});
+        if (clamp)
+            lens.blades = std::clamp(lens.blades, limits::kBlades[0], limits::kBlades[1]);
+    }
 
     // The thin lens only images points beyond its focal length: focus must be farther than f.
     const double focalLengthM = lens.focalLengthMm * 1e-3;

@@ -50,11 +50,16 @@ struct LensSettings {
     FieldOfView fieldOfView = FieldOfView::ImageDistance;
     /// Largest CoC diameter, pixels, [0, 512]; larger blur is clamped to it.
     double maxCocPx = 32.0;
-    /// Rotation of the hexagonal aperture, degrees counter-clockwise as seen in the image,
-    /// [-180, 180]. 0 puts a corner straight up, as Blender Cycles' blade rotation 0 renders
-    /// (measured on data/blender_spheres; see docs/accuracy.md); 30 (or 90) puts a flat edge on
-    /// top, as in McIntosh et al.'s figures.
+    /// Aperture blades: 0 = circular, else the regular polygon's corner count, [3, 16].
+    int blades = 6;
+    /// Rotation of the aperture, degrees counter-clockwise as seen in the image, [-180, 180], as
+    /// Blender Cycles' blade rotation: at 0 an edge's normal points right, so the hexagon has a
+    /// corner straight up (measured on data/blender_spheres; see docs/accuracy.md) and 30 (or 90)
+    /// a flat edge on top, as in McIntosh et al.'s figures.
     double bladeRotationDeg = 0.0;
+    /// Anamorphic squeeze, [0.1, 10]: the aperture's width is divided by it (Cycles' aperture
+    /// ratio): 2 makes tall ovals.
+    double apertureRatio = 1.0;
     /// FocalRange model only: distance where blur reaches max-coc in front of the focus, metres,
     /// [0, focusM).
     double nearLimitM = 1.0;

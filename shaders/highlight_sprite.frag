@@ -1,13 +1,13 @@
 #version 450 core
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// Bokeh sprites, step 2: the hexagon's coverage of this pixel times the sprite's light, added to
+// Bokeh sprites, step 2: the aperture's coverage of this pixel times the sprite's light, added to
 // the output (blending GL_ONE, GL_ONE), where the gather would have brought the same light: to
 // a pixel with a blur of its own (|CoC| >= 1 px), unless it lies in front of the sprite and is
 // sharper (the bleeding rule keeps background blur off sharper foreground); and with the near
 // field, from a sprite in front of the pixel and blurrier than it, whatever the pixel's blur.
 // Pixels in focus are otherwise kept, as the gather keeps them.
 #include "coc_params.glsl"
-#include "hexagon_sprite.glsl"
+#include "aperture_sprite.glsl"
 
 layout(std430, binding = 0) readonly buffer Sprites {
     uint vertexCount; // DrawArraysIndirectCommand (highlight_sprites.comp)
@@ -17,7 +17,7 @@ layout(std430, binding = 0) readonly buffer Sprites {
     uint capacity;
     uint found;
     uint unused[2];
-    vec4 sprites[];   // per sprite: (x, y, signed CoC, hexagon's area), (light rgb, 0)
+    vec4 sprites[];   // per sprite: (x, y, signed CoC of the gather, the aperture's area), (light rgb, 0)
 };
 
 layout(location = 0) in vec2 vOffset;
@@ -33,6 +33,6 @@ void main()
     const float here = signedCoc(texelFetch(uDepth, ivec2(gl_FragCoord.xy), 0).r);
     const bool gathers = abs(here) >= 1.0 && !(here < sprite - 2.0 && abs(here) < abs(sprite));
     const bool foreground = nearField != 0 && sprite < here && abs(sprite) > abs(here);
-    const float coverage = gathers || foreground ? hexagonCoverage(vOffset, vRadius) : 0.0;
+    const float coverage = gathers || foreground ? apertureCoverage(vOffset, vRadius, sprite < 0.0) : 0.0;
     outColor = vec4(vLight.rgb * coverage, 0.0);
 }

@@ -11,7 +11,7 @@
 #include "common.glsl"
 #include "coc_params.glsl"
 #include "highlights.glsl"
-#include "hexagon_sprite.glsl"
+#include "aperture_sprite.glsl"
 
 layout(binding = 0) uniform sampler2D uColor; // sRGB8 textures decode to linear on fetch
 layout(binding = 1) uniform sampler2D uDepth; // metres, holes already filled
@@ -25,7 +25,7 @@ layout(std430, binding = 0) buffer Sprites {
     uint capacity; // the frame's budget of sprites
     uint found;    // the pixels that make one, counted past the budget
     uint unused[2];
-    vec4 sprites[]; // per sprite: (x, y, signed CoC, hexagon's area), (light rgb, 0)
+    vec4 sprites[]; // per sprite: (x, y, signed CoC of the gather, the aperture's area), (light rgb, 0)
 };
 
 layout(std430, binding = 3) readonly buffer HighlightTiles {
@@ -61,7 +61,7 @@ void main()
         return;
     const uint index = atomicAdd(found, 1u);
     if (index < capacity) {
-        sprites[2u * index] = vec4(vec2(texel) + 0.5, coc, hexagonArea(0.5 * abs(coc)));
+        sprites[2u * index] = vec4(vec2(texel) + 0.5, coc, apertureArea(0.5 * abs(coc) / gatherScale));
         sprites[2u * index + 1u] = vec4(color * (1.0 - share), 0.0);
         // Four instances per sprite: itself and its mirror images in the frame's edges
         // (highlight_sprite.vert).

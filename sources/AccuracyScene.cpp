@@ -94,9 +94,12 @@ AccuracyScene parseAccuracyScene(std::string_view jsonText, const fs::path& dir)
     lens.fNumber = number(lensJson, "fNumber", "lens.fNumber", file);
     lens.focusM = number(lensJson, "focusM", "lens.focusM", file);
     const double blades = number(lensJson, "blades", "lens.blades", file);
-    if (blades != 6.0)
-        fail(file, fmt::format("'lens.blades' is {}; the filter draws 6-bladed apertures only", blades));
+    if (blades != std::floor(blades) || !(blades >= 0.0 && blades <= 1000.0))
+        fail(file, fmt::format("'lens.blades' is {}; expected a whole number (0 = circular)", blades));
+    lens.blades = static_cast<int>(blades);
     lens.bladeRotationDeg = number(lensJson, "bladeRotationDeg", "lens.bladeRotationDeg", file);
+    if (lensJson.contains("apertureRatio"))
+        lens.apertureRatio = number(lensJson, "apertureRatio", "lens.apertureRatio", file);
     const std::string fov = text(lensJson, "fieldOfView", "lens.fieldOfView", file);
     if (!parseFieldOfView(fov, lens.fieldOfView))
         fail(file, fmt::format("'lens.fieldOfView' is '{}'; expected 'focal-length' (Blender, engines) or "
@@ -107,7 +110,9 @@ AccuracyScene parseAccuracyScene(std::string_view jsonText, const fs::path& dir)
                                                          {"--f-number", "lens.fNumber"},
                                                          {"--sensor-width", "lens.sensorWidthMm"},
                                                          {"--focus", "lens.focusM"},
-                                                         {"--blade-rotation", "lens.bladeRotationDeg"}};
+                                                         {"--blades", "lens.blades"},
+                                                         {"--blade-rotation", "lens.bladeRotationDeg"},
+                                                         {"--aperture-ratio", "lens.apertureRatio"}};
     for (const SettingIssue& issue : validate(lens)) {
         std::string parameter = issue.parameter;
         for (const auto& [cli, jsonName] : names)

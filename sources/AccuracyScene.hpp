@@ -22,7 +22,8 @@ namespace defocus {
 ///    "depthUnitsPerMetre": 1000,                16-bit depth only; default 1000
 ///    "truth": "truth_linear.exr",
 ///    "lens": {"focalLengthMm": 50, "sensorWidthMm": 36, "fNumber": 1.8, "focusM": 1.2,
-///             "blades": 6, "bladeRotationDeg": 0, "fieldOfView": "focal-length"},
+///             "blades": 6, "bladeRotationDeg": 0, "fieldOfView": "focal-length",
+///             "apertureRatio": 1},                   optional; blades 0 = circular
 ///    "render": {...}}                            optional, kept as text for the report
 struct AccuracyScene {
     std::string name; ///< the folder's name
@@ -38,8 +39,8 @@ struct AccuracyScene {
 };
 
 /// Parses the text of a scene.json that lives in `dir`. Throws SourceError naming
-/// "DIR/scene.json" and the offending field: not JSON, a missing or mistyped field, a value
-/// outside the filter's range, or an aperture other than 6 blades (the filter's only shape).
+/// "DIR/scene.json" and the offending field: not JSON, a missing or mistyped field, or a value
+/// outside the filter's range (blades other than 0 or 3 to 16 among them).
 AccuracyScene parseAccuracyScene(std::string_view json, const std::filesystem::path& dir);
 
 /// Reads DIR/scene.json and checks that the three image files exist. Throws SourceError.

@@ -59,7 +59,7 @@ TEST(AccuracyScene, BundledSpheresSceneHasItsLens)
 }
 
 // Defect caught: a bad scene.json that is accepted with a default (a missing f-number read as
-// 2, a 5-bladed truth measured against hexagons) or rejected with a message that names neither
+// 2, a 2-bladed aperture, which no lens has, or a squeeze of 0) or rejected with a message that names neither
 // the file nor the field.
 TEST(AccuracyScene, EachBadFieldIsNamed)
 {
@@ -74,7 +74,9 @@ TEST(AccuracyScene, EachBadFieldIsNamed)
         {replaced(kGood, R"("fNumber": 1.8)", R"("fNumber": "1.8")"), "'lens.fNumber' must be a number"},
         {replaced(kGood, R"("fNumber": 1.8)", R"("fNumber": 0.5)"), "'lens.fNumber': --f-number must be between 0.7 and 64, not 0.5"},
         {replaced(kGood, R"("focusM": 1.2)", R"("focusM": 0.01)"), "'lens.focusM'"},
-        {replaced(kGood, R"("blades": 6)", R"("blades": 5)"), "'lens.blades' is 5; the filter draws 6-bladed"},
+        {replaced(kGood, R"("blades": 6)", R"("blades": 2)"), "'lens.blades': --blades must be 0 (circular) or between 3 and 16, not 2"},
+        {replaced(kGood, R"("blades": 6)", R"("blades": 5.5)"), "'lens.blades' is 5.5; expected a whole number"},
+        {replaced(kGood, R"("blades": 6,)", R"("blades": 6, "apertureRatio": 0,)"), "'lens.apertureRatio': --aperture-ratio must be between 0.1 and 10, not 0"},
         {replaced(kGood, R"("focal-length")", R"("sensor")"), "'lens.fieldOfView' is 'sensor'"},
         {replaced(kGood, R"("color": "c.exr")", R"("color": "")"), "'color' must be a non-empty string"},
         {replaced(kGood, R"("truth": "t.exr",)", R"("truth": "t.exr", "depthUnitsPerMetre": -5,)"),
@@ -85,6 +87,20 @@ TEST(AccuracyScene, EachBadFieldIsNamed)
         EXPECT_NE(message.find(c.expected), std::string::npos) << "got: " << message << "\nexpected: " << c.expected;
         EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     }
+}
+
+// Defect caught: a scene's aperture read as the default hexagon: a circular or 9-bladed, rotated,
+// squeezed truth measured against hexagons.
+TEST(AccuracyScene, ApertureIsTheTruths)
+{
+    std::string json = replaced(kGood, R"("blades": 6)", R"("blades": 9)");
+    json = replaced(json, R"("bladeRotationDeg": 0)", R"("bladeRotationDeg": 15, "apertureRatio": 2)");
+    const AccuracyScene scene = parseAccuracyScene(json, "scenes/x");
+    EXPECT_EQ(scene.lens.blades, 9);
+    EXPECT_EQ(scene.lens.bladeRotationDeg, 15.0);
+    EXPECT_EQ(scene.lens.apertureRatio, 2.0);
+    EXPECT_EQ(parseAccuracyScene(replaced(kGood, R"("blades": 6)", R"("blades": 0)"), "scenes/x").lens.blades, 0);
+    EXPECT_EQ(parseAccuracyScene(kGood, "scenes/x").lens.apertureRatio, 1.0);
 }
 
 // Defect caught: a corpus folder whose scenes are not found (or found in another order), or

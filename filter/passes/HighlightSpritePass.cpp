@@ -9,6 +9,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <numbers>
 #include <vector>
@@ -25,13 +26,21 @@ namespace {
 constexpr std::size_t kHeaderBytes = 8 * sizeof(std::uint32_t);
 constexpr std::size_t kSpriteBytes = 8 * sizeof(float);
 
-/// Mirrors the std140 block SpriteParams in hexagon_sprite.glsl.
+/// Mirrors the std140 block SpriteParams in aperture_sprite.glsl.
 struct SpriteParams {
     float frameSize[2];
-    float corner[2];
+    float ratio;
+    int edgeCount;
     int nearField;
-    int pad[3];
+    float gatherScale;
+    float fanScale;
+    float fanMargin;
+    float fanCorner[2];
+    float unitArea;
+    float unused;
+    float edges[4 * 16];
 };
+static_assert(offsetof(SpriteParams, fanCorner) == 32 && offsetof(SpriteParams, edges) == 48);
 
 } // namespace
 
@@ -47,14 +56,28 @@ HighlightSpritePass::HighlightSpritePass()
 {
 }
 
-void HighlightSpritePass::updateSpriteParams(const gl::Texture& depth, float bladeRotationDeg, bool nearField)
+void HighlightSpritePass::updateSpriteParams(const gl::Texture& depth, const ApertureShape& shape, bool nearField)
 {
-    // A corner at 90 degrees + the rotation, counter-clockwise on screen: y runs down the rows.
-    const double corner = (90.0 + bladeRotationDeg) * std::numbers::pi / 180.0;
-    const SpriteParams params{{static_cast<float>(depth.width()), static_cast<float>(depth.height())},
-                              {static_cast<float>(std::cos(corner)), static_cast<float>(-std::sin(corner))},
-                              nearField ? 1 : 0,
-                              {}};
+    const ApertureEdges edges = apertureEdges(shape);
+    SpriteParams params{};
+    params.frameSize[0] = static_cast<float>(depth.width());
+    params.frameSize[1] = static_cast<float>(depth.height());
+    params.ratio = edges.ratio;
+    params.edgeCount = edges.count;
+    params.nearField = nearField ? 1 : 0;
+    params.gatherScale = gatherScale(shape);
+    params.unitArea = static_cast<float>(apertureArea(shape));
+    std::copy(edges.edges.begin(), edges.edges.end(), params.edges);
+    // The fan (highlight_sprite.vert): the hexagon's own corners 0.81 px out, a corner at 90
+    // degrees + the rotation, counter-clockwise on screen (y runs down the rows); for other
+    // shapes the hexagon around the circle 0.71 px beyond their circumradius (that much
+    // further where the squeeze widens them), corner up.
+    const double corner = shape.isHexagon() ? (90.0 + shape.rotationDeg) * std::numbers::pi / 180.0 : std::numbers::pi / 2;
+    params.fanCorner[0] = static_cast<float>(std::cos(corner));
+    params.fanCorner[1] = static_cast<float>(-std::sin(corner));
+    const float toCorner = shape.isHexagon() ? 1.0f : 1.0f / std::cos(static_cast<float>(std::numbers::pi) / 6.0f);
+    params.fanScale = toCorner;
+    params.fanMargin = shape.isHexagon() ? 0.81f : 0.71f * std::max(shape.ratio, 1.0f) * toCorner;
     spriteParams_.update(&params, sizeof params);
 }
 
@@ -64,7 +87,7 @@ std::size_t HighlightSpritePass::budget(std::size_t pixels, std::size_t highligh
 }
 
 void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k,
-                               float highlightGain, float largestColor, float bladeRotationDeg, bool nearField,
+                               float highlightGain, float largestColor, const ApertureShape& shape, bool nearField,
                                const gl::StorageBuffer& neighbourhoods, const std::vector<cv::Point>& tiles,
                                std::size_t budget)
 {
@@ -85,7 +108,7 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
     neighbourhoods.bind(1);
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
-    updateSpriteParams(depth, bladeRotationDeg, nearField);
+    updateSpriteParams(depth, shape, nearField);
     spriteParams_.bind(1);
     if (!tiles.empty()) {
         static_assert(sizeof(cv::Point) == 2 * sizeof(std::int32_t));

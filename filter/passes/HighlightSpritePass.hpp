@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Bokeh sprites for highlights: the light of blurred pixels brighter than a threshold, which the
-// CoC pass takes out of the gather, scattered as hexagons with exact edges and added to the
-// output. Runs only on frames with highlights. Shaders: highlight_sprites.comp (find them, on the
+// CoC pass takes out of the gather, scattered in the aperture's shape with exact edges and added to
+// the output. Runs only on frames with highlights. Shaders: highlight_sprites.comp (find them, on the
 // GPU, into an indirect draw), highlight_sprite.vert/.frag (draw them).
 #pragma once
 
@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "filter/Aperture.hpp"
 #include "filter/Lens.hpp"
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
@@ -29,13 +30,13 @@ public:
 
     HighlightSpritePass();
     /// Step 1, before the CoC pass: finds the sprites in `color` (sRGB8 or float RGB) and `depth`
-    /// (R32F metres, filled) with the CoC pass' settings (`k`, `highlightGain`, `largestColor`,
-    /// the tiles' `neighbourhoods`, SceneAnalysis::tileNeighbourhood) and the hexagon's (`bladeRotationDeg`, `nearField`), at
-    /// most `budget` of them; a frame with more draws none, and the CoC pass (reading sprites())
+    /// (R32F metres, filled) with the CoC pass' settings (`k`, the gather's CoC, `highlightGain`,
+    /// `largestColor`, the tiles' `neighbourhoods`, SceneAnalysis::tileNeighbourhood) and the
+    /// aperture's (`shape`, whose gatherScale() `k` holds, `nearField`), at most `budget` of them; a frame with more draws none, and the CoC pass (reading sprites())
     /// then keeps all of their light. Only the 16x16 `tiles` (SceneAnalysis::highlightTiles) are
     /// searched: no pixel elsewhere is bright enough.
     void find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, float highlightGain,
-              float largestColor, float bladeRotationDeg, bool nearField, const gl::StorageBuffer& neighbourhoods,
+              float largestColor, const ApertureShape& shape, bool nearField, const gl::StorageBuffer& neighbourhoods,
               const std::vector<cv::Point>& tiles, std::size_t budget);
     /// Step 2: adds the sprites found to `target` (the frame's size, linear or sRGB with
     /// GL_FRAMEBUFFER_SRGB) where the gather would have spread their light (with the near field:
@@ -50,8 +51,8 @@ public:
     static std::size_t budget(std::size_t pixels, std::size_t highlightPixels);
 
 private:
-    /// Fills the SpriteParams block (hexagon_sprite.glsl) for a frame of `depth`'s size.
-    void updateSpriteParams(const gl::Texture& depth, float bladeRotationDeg, bool nearField);
+    /// Fills the SpriteParams block (aperture_sprite.glsl) for a frame of `depth`'s size.
+    void updateSpriteParams(const gl::Texture& depth, const ApertureShape& shape, bool nearField);
 
     gl::Program find_, settle_, draw_;
     gl::UniformBuffer cocParams_, spriteParams_;

@@ -46,9 +46,16 @@ struct Lens {
     double nearM = 1.0;
     /// FocalRange only: metres where blur behind the focus reaches maxCocPx, (focus, +inf]. Default 6.
     double farM = 6.0;
-    /// Hexagon rotation, degrees counter-clockwise, [-180, 180]; 0 = a corner on top (as
-    /// Blender Cycles), 30 = a flat top. Default 0.
+    /// Aperture blades: 0 for a circular aperture, else the regular polygon's corner count,
+    /// [3, 16]. Default 6 (a hexagon). --blades
+    int blades = 6;
+    /// Aperture rotation, degrees counter-clockwise, [-180, 180], as Blender Cycles' blade
+    /// rotation: at 0 one edge faces right, so a hexagon has a corner on top (30 = a flat top)
+    /// and a pentagon a corner pointing left. Default 0. --blade-rotation
     double bladeRotationDeg = 0.0;
+    /// Anamorphic squeeze, (Cycles' aperture ratio), [0.1, 10]: the aperture's width is divided
+    /// by it, so 2 gives tall ovals, 0.5 wide ones. Default 1. --aperture-ratio
+    double apertureRatio = 1.0;
 };
 
 /// How the focus distance is chosen.
@@ -156,6 +163,9 @@ inline constexpr double kFNumber[] = {0.7, 64.0};
 inline constexpr double kSensorWidthMm[] = {1.0, 100.0};
 inline constexpr double kMaxCocPx[] = {0.0, 512.0};
 inline constexpr double kBladeRotationDeg[] = {-180.0, 180.0};
+/// Lens::blades: 0 (circular) or this range.
+inline constexpr int kBlades[] = {3, 16};
+inline constexpr double kApertureRatio[] = {0.1, 10.0};
 inline constexpr int kSamples[] = {2, 64};
 inline constexpr double kHighlightGain[] = {1.0, 64.0};
 /// Lens::focusM: +inf included; check() also holds it beyond the focal length.

@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// The aperture's shape, as Blender Cycles samples it: a regular polygon of `blades` corners on the
+// circle of the aperture's diameter (or that circle), rotated, its width divided by the
+// anamorphic ratio. Lights scatter with its exact edges (the bokeh sprites); the gather of
+// everything else is the rhombi's hexagon, scaled to the aperture's area.
+#pragma once
+
+#include <array>
+
+#include "filter/Settings.hpp"
+
+namespace defocus {
+
+struct ApertureShape {
+    int blades = 6;          ///< 0 = circle
+    float rotationDeg = 0.0f; ///< counter-clockwise in the image; at 0 an edge faces right
+    float ratio = 1.0f;      ///< the width is divided by it
+
+    static ApertureShape of(const LensSettings& lens);
+    /// A regular hexagon, unsqueezed: the shape the rhombi gather draws exactly.
+    bool isHexagon() const { return blades == 6 && ratio == 1.0f; }
+    bool isCircle() const { return blades == 0; }
+};
+
+/// The shape's area for a circumradius of 1 (the CoC's radius): n/2 sin(2 pi / n) for a polygon,
+/// pi for the circle, divided by the ratio.
+double apertureArea(const ApertureShape& shape);
+
+/// The factor the gather's CoC is scaled by so that its hexagon (area 3 sqrt(3) / 2 R^2) covers
+/// the aperture's area: what a light spreads over is then the aperture's, and the blur's
+/// spread (its second moment) is within 0.4 % of a circle's. Exactly 1 for the hexagon.
+float gatherScale(const ApertureShape& shape);
+
+/// The sprites' edges (aperture.glsl), in pixels with y down the rows: for each edge k < 16, the
+/// unit normal (x, y) and the distance of the edge from the centre per pixel of circumradius;
+/// `count` edges, 0 for the circle, whose squeeze is `ratio`.
+struct ApertureEdges {
+    std::array<float, 4 * 16> edges{}; ///< (nx, ny, distance per radius, 0) per edge
+    int count = 0;
+    float ratio = 1.0f;
+};
+ApertureEdges apertureEdges(const ApertureShape& shape);
+
+/// The share of the pixel at `offsetX`, `offsetY` (pixels from the centre, y down) that the
+/// shape of circumradius `radius` covers, behind the focus (`near`: in front of it, where the
+/// image of the aperture is turned by 180 degrees), with half a pixel of ramp either side of the
+/// edge: aperture.glsl's apertureCoverage() on the CPU, for tests.
+float apertureCoverage(const ApertureShape& shape, float offsetX, float offsetY, float radius, bool near);
+
+} // namespace defocus
