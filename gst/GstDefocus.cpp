@@ -98,7 +98,9 @@ enum Property {
     PROP_NEAR_FIELD,
     PROP_HIGHLIGHT_SPRITES,
     PROP_HIGHLIGHT_GAIN,
+    PROP_BLADES,
     PROP_BLADE_ROTATION,
+    PROP_APERTURE_RATIO,
     PROP_DEPTH_SCALE,
     PROP_VIEW,
     PROP_POST_TIMINGS,
@@ -279,7 +281,9 @@ void setProperty(GObject* object, guint id, const GValue* value, GParamSpec* psp
             break;
         case PROP_HIGHLIGHT_SPRITES: st.quality.highlightSprites = g_value_get_boolean(value) != FALSE; break;
         case PROP_HIGHLIGHT_GAIN: st.quality.highlightGain = g_value_get_double(value); break;
+        case PROP_BLADES: st.lens.blades = g_value_get_int(value); break;
         case PROP_BLADE_ROTATION: st.lens.bladeRotationDeg = g_value_get_double(value); break;
+        case PROP_APERTURE_RATIO: st.lens.apertureRatio = g_value_get_double(value); break;
         case PROP_DEPTH_SCALE: st.depthScale = g_value_get_double(value); break;
         case PROP_VIEW: st.view = static_cast<defocus::Settings::View>(g_value_get_enum(value)); break;
         case PROP_POST_TIMINGS: s.postTimings = g_value_get_boolean(value) != FALSE; break;
@@ -325,7 +329,9 @@ void getProperty(GObject* object, guint id, GValue* value, GParamSpec* pspec)
     case PROP_NEAR_FIELD: g_value_set_boolean(value, st.quality.nearField.value_or(true)); break;
     case PROP_HIGHLIGHT_SPRITES: g_value_set_boolean(value, st.quality.highlightSprites); break;
     case PROP_HIGHLIGHT_GAIN: g_value_set_double(value, st.quality.highlightGain); break;
+    case PROP_BLADES: g_value_set_int(value, st.lens.blades); break;
     case PROP_BLADE_ROTATION: g_value_set_double(value, st.lens.bladeRotationDeg); break;
+    case PROP_APERTURE_RATIO: g_value_set_double(value, st.lens.apertureRatio); break;
     case PROP_DEPTH_SCALE: g_value_set_double(value, st.depthScale); break;
     case PROP_VIEW: g_value_set_enum(value, static_cast<int>(st.view)); break;
     case PROP_POST_TIMINGS: g_value_set_boolean(value, s.postTimings); break;
@@ -1373,14 +1379,23 @@ static void gst_defocus_class_init(GstDefocusClass* klass)
     g_object_class_install_property(
         gobject, PROP_HIGHLIGHT_SPRITES,
         g_param_spec_boolean("highlight-sprites", "highlight-sprites",
-                             "Rhombi: lights brighter than white scatter as hexagons with exact edges", TRUE, kFlags));
+                             "Rhombi: lights brighter than white scatter in the aperture's shape with exact edges", TRUE, kFlags));
     installDouble(gobject, PROP_HIGHLIGHT_GAIN, "highlight-gain",
                   "Scale near-clipped pixels that get blurred up to this, so lights bloom (1 = off)",
                   limits::kHighlightGain[0], limits::kHighlightGain[1], defaults.quality.highlightGain);
+    g_object_class_install_property(
+        gobject, PROP_BLADES,
+        g_param_spec_int("blades", "blades",
+                         "Aperture blades: 0 = circular, else the polygon's corners, 3..16 (1 and 2 become 3)", 0,
+                         limits::kBlades[1], defaults.lens.blades, kControllable));
     installDouble(gobject, PROP_BLADE_ROTATION, "blade-rotation",
-                  "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top, 30 = flat top",
+                  "Aperture rotation, degrees counter-clockwise, as Blender Cycles: at 0 an edge faces right "
+                  "(the hexagon's corner on top; 30 = flat top)",
                   limits::kBladeRotationDeg[0], limits::kBladeRotationDeg[1], defaults.lens.bladeRotationDeg,
                   kControllable);
+    installDouble(gobject, PROP_APERTURE_RATIO, "aperture-ratio",
+                  "Anamorphic squeeze: the aperture's width is divided by it (2 = tall ovals)",
+                  limits::kApertureRatio[0], limits::kApertureRatio[1], defaults.lens.apertureRatio, kControllable);
     installDouble(gobject, PROP_DEPTH_SCALE, "depth-scale", "Units per metre of the 16-bit depth (TUM RGB-D: 5000)",
                   limits::kDepthScale[0], limits::kDepthScale[1], defaults.depthScale);
     g_object_class_install_property(

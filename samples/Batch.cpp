@@ -181,7 +181,7 @@ const std::vector<std::string_view>& clipOptions()
 {
     static const std::vector<std::string_view> names{
         "depth-scale", "focus", "f-number", "focal-length", "sensor-width", "fov-from", "max-coc", "coc-model",
-        "near", "far", "quality", "samples", "hexagon", "blade-rotation", "precision", "resolution", "view",
+        "near", "far", "quality", "samples", "hexagon", "blades", "blade-rotation", "aperture-ratio", "precision", "resolution", "view",
         "frames", "start", "every", "focus-point", "tau", "fps", "highlight-gain", "near-field", "no-near-field",
         "highlight-sprites", "no-highlight-sprites", "always-on", "contact-sheet", "contact-frame", "timings",
         "codec", "image-format"};

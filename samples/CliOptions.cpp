@@ -187,8 +187,15 @@ void addLensOptions(CLI::App& app, Lens& lens, LensNames& names, FocalRange rang
                                    "[default: 3 x the focus]",
                                    defaults.farM));
     }
+    app.add_option("--blades", lens.blades,
+                   "Aperture blades: 0 = a circular aperture, else the polygon's corners, 3 to 16 (as Blender Cycles)")
+        ->capture_default_str();
     app.add_option("--blade-rotation", lens.bladeRotationDeg,
-                   "Hexagon rotation, degrees counter-clockwise; 0 = a corner on top (as Blender Cycles), 30 = flat top")
+                   "Aperture rotation, degrees counter-clockwise, as Blender Cycles: at 0 an edge faces right "
+                   "(the hexagon's corner is on top; 30 = flat top)")
+        ->capture_default_str();
+    app.add_option("--aperture-ratio", lens.apertureRatio,
+                   "Anamorphic squeeze, as Blender Cycles: the aperture's width is divided by it (2 = tall ovals)")
         ->capture_default_str();
 }
 

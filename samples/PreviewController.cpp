@@ -42,6 +42,25 @@ std::string rangeText(const Lens& lens)
     return fmt::format("focal range {:.2f}-{:.2f} m", lens.nearM, lens.farM);
 }
 
+/// The aperture in a few words: "6 blades", "circle", "9 blades 15 deg", "circle, ratio 2".
+std::string apertureText(const Lens& lens)
+{
+    std::string text = lens.blades == 0 ? "circle" : fmt::format("{} blades", lens.blades);
+    if (lens.blades != 0 && lens.bladeRotationDeg != 0.0)
+        text += fmt::format(" {:g} deg", lens.bladeRotationDeg);
+    if (lens.apertureRatio != 1.0)
+        text += fmt::format(", ratio {:g}", lens.apertureRatio);
+    return text;
+}
+
+/// The blade count after `blades`: 6, 7 ... 16, then the circle, then 3, 4, 5 and 6 again.
+int nextBlades(int blades)
+{
+    if (blades == 0)
+        return 3;
+    return blades >= 16 ? 0 : blades + 1;
+}
+
 /// Short GPU pass names so that one line holds them all at 560 px.
 std::string_view shortPassName(std::string_view name)
 {
@@ -90,6 +109,18 @@ KeyOutcome applyKey(LiveControls& controls, int key, double focusM)
         controls.nearRatio = key == 'j' ? controls.nearRatio / 1.25 : controls.nearRatio * 1.25;
         controls.farRatio = key == 'j' ? controls.farRatio * 1.25 : controls.farRatio / 1.25;
         lensChanged = true;
+        break;
+    case 'b':
+        lens.blades = nextBlades(lens.blades);
+        outcome.message = "aperture: " + apertureText(lens);
+        break;
+    case 'r':
+        lens.bladeRotationDeg = std::remainder(lens.bladeRotationDeg + 15.0, 360.0);
+        outcome.message = "aperture: " + apertureText(lens);
+        break;
+    case 'o':
+        lens.apertureRatio = lens.apertureRatio == 1.0 ? 2.0 : 1.0;
+        outcome.message = "aperture: " + apertureText(lens);
         break;
     case 'm':
         lens.cocModel = lens.cocModel == Lens::Model::ThinLens ? Lens::Model::FocalRange : Lens::Model::ThinLens;
@@ -176,8 +207,8 @@ Hud hudFor(const HudStatus& status, const Plan* tileMap)
         gpu += fmt::format("  {} {:.1f}", shortPassName(pass.name), pass.ms);
     const Timings& t = status.timings;
     hud.lines = {
-        fmt::format("{}   f/{}  {:.0f} mm  max CoC {:.1f} px  {}", focus, fNumberText(lens.fNumber), lens.focalLengthMm,
-                    lens.maxCocPx, rangeText(lens)),
+        fmt::format("{}   f/{}  {:.0f} mm  max CoC {:.1f} px  {}  {}", focus, fNumberText(lens.fNumber),
+                    lens.focalLengthMm, lens.maxCocPx, rangeText(lens), apertureText(lens)),
         fmt::format("view {} {}   {:.1f} fps   latency {:.0f} ms   dropped {}   frame {}{}{}", viewNumber(status.view),
                     viewName(status.view), status.fps, status.latencyMs, status.dropped, status.frameIndex,
                     status.live ? " (live)" : "", state),
@@ -185,8 +216,8 @@ Hud hudFor(const HudStatus& status, const Plan* tileMap)
                     t.totalMs, t.depthPrepMs, t.analysisMs, t.uploadMs, t.renderMs, t.readbackMs),
         "gpu ms/pass:" + (gpu.empty() ? std::string("  n/a") : gpu),
     };
-    hud.note = status.message.empty() ? std::string("keys: 1-7 view  +/- f-number  [ ] max CoC  j/l range  f autofocus  "
-                                                    "t tiles  spc pause  s shot  q quit")
+    hud.note = status.message.empty() ? std::string("keys: 1-7 view  +/- f-number  [ ] max CoC  j/l range  b/r/o aperture  "
+                                                    "f autofocus  t tiles  spc pause  s shot  q quit")
                                       : status.message;
     hud.warning = status.warning;
     return hud;

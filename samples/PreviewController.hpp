@@ -51,6 +51,7 @@ struct LiveControls {
 /// Keys, one line, for the HUD and --help.
 inline constexpr const char* kKeyHelp =
     "1-5 lab views, 6 depth, 7 CoC | +/- f-number | [ ] max CoC | j/l focal range | m model | "
+    "b blades | r rotate aperture | o oval | "
     "f autofocus | c centre | t tiles | space pause | s screenshot | q quit | click: focus";
 
 /// What applying a key did, for the log and the HUD.

@@ -79,6 +79,7 @@ protected:
         cv::imwrite((dir_ / "near_focus.png").string(), planes(600, 1000));   // 0.6 m | 1 m
         cv::imwrite((dir_ / "focus_far.png").string(), planes(1000, 3000));   // 1 m | 3 m
         cv::imwrite((dir_ / "far81.png").string(), planes(3000, 3000, {81, 81}));
+        cv::imwrite((dir_ / "near81.png").string(), planes(700, 700, {81, 81}));
 
         // One pixel of linear 1.0 (white, not above it) on black, for the hexagon's shape and energy.
         cv::Mat point(81, 81, CV_32FC3, cv::Scalar::all(0));
@@ -88,6 +89,10 @@ protected:
         cv::Mat light(81, 81, CV_32FC3, cv::Scalar::all(0.2));
         light(cv::Rect(39, 39, 3, 3)).setTo(cv::Scalar::all(30.0));
         EXPECT_TRUE(cv::imwrite((dir_ / "light.exr").string(), light));
+        // One lamp 100 times white on black: all of its light goes to a bokeh sprite.
+        cv::Mat lamp(81, 81, CV_32FC3, cv::Scalar::all(0));
+        lamp.at<cv::Vec3f>(40, 40) = {100.0f, 100.0f, 100.0f};
+        EXPECT_TRUE(cv::imwrite((dir_ / "lamp.exr").string(), lamp));
         // 8-bit colour with a clipped light, for --highlight-gain.
         cv::Mat clipped(81, 81, CV_8UC3, cv::Scalar::all(60));
         clipped(cv::Rect(38, 38, 5, 5)).setTo(cv::Scalar::all(255));
@@ -293,6 +298,61 @@ TEST_F(CliFlags, BladeRotationPutsACornerOrAnEdgeOnTop)
     EXPECT_GT(corner, 0);
     EXPECT_LE(corner, 3);
     EXPECT_GE(edge, 7) << "corner on top: " << corner << " px";
+}
+
+// Defect: --blades or --aperture-ratio ignored, or the shape drawn the wrong way round, or its
+// light not kept. A lamp 100 times white becomes the aperture's shape, 21 px across, as Blender
+// Cycles draws it: behind the focus a 5-bladed aperture at rotation 0 has a flat edge on the right
+// (an edge's normal points right) and a corner on the left; in front of the focus the lens turns
+// it by 180 degrees; the circle covers pi / (3 sqrt(3) / 2) = 1.21 times the hexagon's area; a
+// ratio of 2 makes an oval twice as tall as wide. Each keeps the lamp's light (the sum, 100).
+TEST_F(CliFlags, BladesAndApertureRatioShapeTheLights)
+{
+    struct Shape {
+        cv::Mat lit; // the pixels above a quarter of the peak
+        double light = 0.0;
+    };
+    const auto lamp = [&](const std::string& depth, const std::string& aperture) {
+        const cv::Mat out = render(fmt::format("'{}' --depth '{}' --coc-model focal-range --focus 1 --near 0.5 --far 2 "
+                                               "--max-coc 21 --quality high {}",
+                                               file("lamp.exr").string(), file(depth).string(), aperture),
+                                   ".exr");
+        Shape shape;
+        if (out.empty())
+            return shape;
+        std::vector<cv::Mat> channels;
+        cv::split(out, channels);
+        double peak = 0;
+        cv::minMaxLoc(channels[1], nullptr, &peak);
+        shape.lit = channels[1] > 0.25 * peak;
+        shape.light = cv::sum(channels[1])[0];
+        return shape;
+    };
+    // The lit pixels of the leftmost and rightmost lit columns.
+    const auto ends = [](const cv::Mat& lit) {
+        const cv::Rect box = cv::boundingRect(lit);
+        return std::pair{cv::countNonZero(lit.col(box.x)), cv::countNonZero(lit.col(box.x + box.width - 1))};
+    };
+    const Shape hexagon = lamp("far81.png", "");
+    const Shape circle = lamp("far81.png", "--blades 0");
+    const Shape pentagon = lamp("far81.png", "--blades 5");
+    const Shape nearPentagon = lamp("near81.png", "--blades 5");
+    const Shape oval = lamp("far81.png", "--blades 0 --aperture-ratio 2");
+    for (const Shape* s : {&hexagon, &circle, &pentagon, &nearPentagon, &oval}) {
+        ASSERT_FALSE(s->lit.empty());
+        EXPECT_NEAR(s->light, 100.0, 1.0);
+    }
+    const double areas = static_cast<double>(cv::countNonZero(circle.lit)) / cv::countNonZero(hexagon.lit);
+    EXPECT_NEAR(areas, 1.209, 0.08);
+    // The pentagon's edge is 2 R sin 36 deg = 12 px long; its corner a column of a few pixels.
+    const auto [farLeft, farRight] = ends(pentagon.lit);
+    EXPECT_LE(farLeft, 4);
+    EXPECT_GE(farRight, 9);
+    const auto [nearLeft, nearRight] = ends(nearPentagon.lit);
+    EXPECT_GE(nearLeft, 6); // 12.6 px across in front: an edge of 7 px
+    EXPECT_LE(nearRight, 4);
+    const cv::Rect box = cv::boundingRect(oval.lit);
+    EXPECT_NEAR(static_cast<double>(box.height) / box.width, 2.0, 0.25) << box;
 }
 
 // Defect: --hexagon ignored or the kernels swapped. The rhombi keep a point's light (the sum of
@@ -836,7 +896,7 @@ TEST(CliVocabulary, PreviewAndBenchDeclareTheSharedOptionsAsDefocusDoes)
                                            "--resolution", "--near-field",       "--highlight-sprites",
                                            "--highlight-gain"};
     std::vector<std::string> shared{"--depth-scale", "--f-number",   "--focal-length",   "--sensor-width",
-                                    "--fov-from",    "--max-coc",    "--coc-model",      "--blade-rotation",
+                                    "--fov-from",    "--max-coc",    "--coc-model",      "--blade-rotation", "--blades", "--aperture-ratio",
                                     "--size",        "--camera-fps", "--pixel-format"};
     shared.insert(shared.end(), quality.begin(), quality.end());
     const auto same = [&](const std::map<std::string, std::string>& other, const std::string& program,
@@ -884,6 +944,8 @@ TEST_F(CliFlags, EveryOptionInTheHelpHasATest)
         {"--samples", "CliFlags.SamplesSetTheTapsPerLine"},
         {"--hexagon", "CliFlags.HexagonRhombiKeepALightsEnergyAndMcIntoshsMinimumDoesNot"},
         {"--blade-rotation", "CliFlags.BladeRotationPutsACornerOrAnEdgeOnTop"},
+        {"--blades", "CliFlags.BladesAndApertureRatioShapeTheLights"},
+        {"--aperture-ratio", "CliFlags.BladesAndApertureRatioShapeTheLights"},
         {"--precision", "CliFlags.PrecisionSetsTheTargetFormat"},
         {"--resolution", "CliFlags.ResolutionHalfKeepsTheSizeAndTheInFocusPixels"},
         {"--view", "CliFlags.ViewWritesEachStage"},
