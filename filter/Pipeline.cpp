@@ -309,11 +309,12 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
 
     // All in focus? Hole filling only averages valid depths, so the valid range bounds the
     // filled map, and CoC is monotonic in depth: the CoC of the two ends decides, before any
-    // hole filling, analysis or upload.
+    // hole filling, analysis or upload. The lens' CoC: a lens that blurs nothing by half a pixel
+    // passes the frame through whatever the gather's scale.
     if (quality.adaptive) {
         float lo = p.fallbackDepth, hi = p.fallbackDepth;
         p.invalidFraction = validDepthRange(frame.depth, lo, hi);
-        const float c0 = cocPixels(p.coefficients, lo), c1 = cocPixels(p.coefficients, hi);
+        const float c0 = cocPixels(lensCoc, lo), c1 = cocPixels(lensCoc, hi);
         if (std::max(std::abs(c0), std::abs(c1)) < 0.5f) {
             p.analysis = {};
             p.analysis.minCoc = std::min(c0, c1);

@@ -21,6 +21,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "filter/Aperture.hpp"
 #include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
@@ -682,13 +683,33 @@ void keepWorst(double value, double& worstValue, std::string& worstAt, const std
 }
 
 /// The quality setting called `name`: a preset, or a kernel with the plain settings.
-QualitySettings namedQuality(const std::string& name)
+QualitySettings namedQuality(std::string name)
 {
+    name = name.substr(0, name.find('_'));
     for (const auto& q : test::presetsAndKernels())
         if (q.name == name)
             return q.quality;
     ADD_FAILURE() << "no quality setting called " << name;
     return {};
+}
+
+/// The aperture a quality name ends in after '_' (the hexagon without): "circle", "nonagon" (9
+/// blades turned by 20 degrees), "oval" (a circle squeezed 2:1). The case's own settings come
+/// after it, so a case that sets the aperture still does.
+void applyAperture(const std::string& name, LensSettings& lens)
+{
+    const std::string aperture = name.find('_') == std::string::npos ? "" : name.substr(name.find('_') + 1);
+    if (aperture == "circle") {
+        lens.blades = 0;
+    } else if (aperture == "nonagon") {
+        lens.blades = 9;
+        lens.bladeRotationDeg = 20.0;
+    } else if (aperture == "oval") {
+        lens.blades = 0;
+        lens.apertureRatio = 2.0;
+    } else if (!aperture.empty()) {
+        ADD_FAILURE() << "no aperture called " << aperture;
+    }
 }
 
 /// A case and the quality setting it runs with.
@@ -720,6 +741,7 @@ TEST_P(HardCases, FiniteInRangeInFocusKeptAndContinuous)
     const std::string& qualityName = std::get<1>(GetParam());
     Worst& worst = worstByQuality()[qualityName];
     LensSettings lens = baseLens();
+    applyAperture(qualityName, lens);
     QualitySettings quality = namedQuality(qualityName);
     if (c.setup)
         c.setup(lens, quality);
@@ -775,7 +797,9 @@ TEST_P(HardCases, FiniteInRangeInFocusKeptAndContinuous)
     // which can leave the input's range in a channel that was small; the output puts the light
     // back (in_focus_light.frag). The targets' pixels of such lights are checked to hold no more
     // than the threshold's luminance below, and left out of the range.
-    const cv::Mat sharp = cv::abs(out.targets[0].coc) < 0.5f;
+    // In focus: the lens' CoC under half a pixel; the targets hold the gather's, the lens' scaled
+    // to the aperture's area (up to 1.1 times, which the rhombi still pass through below 1 px).
+    const cv::Mat sharp = cv::abs(out.targets[0].coc) < 0.5f * gatherScale(ApertureShape::of(lens));
     cv::Mat heldBack(c.size, CV_8U, cv::Scalar(0));
     const auto luminance = [](const cv::Vec3f& v) { return 0.2126 * v[2] + 0.7152 * v[1] + 0.0722 * v[0]; };
     if (pipeline.plan().highlightSprites) {
@@ -787,8 +811,10 @@ TEST_P(HardCases, FiniteInRangeInFocusKeptAndContinuous)
     }
     // No NaN or Inf anywhere; every target's colour inside the input's range (each pass is a
     // convex combination of its source; composite is a min of two of them); every CoC inside
-    // [-max-coc, max-coc] (the blur averages CoCs too, so this holds after every pass).
-    const double cocSlack = lens.maxCocPx * relativeTolerance(quality.targetFormat) + kAbsoluteTolerance;
+    // [-max-coc, max-coc] of the gather (the lens' scaled to the aperture's area; the blur
+    // averages CoCs too, so this holds after every pass).
+    const double maxCoc = lens.maxCocPx * gatherScale(ApertureShape::of(lens));
+    const double cocSlack = maxCoc * relativeTolerance(quality.targetFormat) + kAbsoluteTolerance;
     std::string first;
     for (int i = 0; i < 4; ++i) {
         const std::string_view target = viewName(kTargets[i]);
@@ -799,8 +825,8 @@ TEST_P(HardCases, FiniteInRangeInFocusKeptAndContinuous)
             << target << ": " << first;
         double lo = 0, hi = 0;
         cv::minMaxLoc(out.targets[i].coc, &lo, &hi);
-        EXPECT_GE(lo, -lens.maxCocPx - cocSlack) << target;
-        EXPECT_LE(hi, lens.maxCocPx + cocSlack) << target;
+        EXPECT_GE(lo, -maxCoc - cocSlack) << target;
+        EXPECT_LE(hi, maxCoc + cocSlack) << target;
     }
     ASSERT_TRUE(test::allFinite(out.linear)) << "composite";
     EXPECT_EQ(countOutOfRange(out.linear, ref.lo, ref.hi, ref.loSlack, ref.hiSlack, first), 0) << "composite: " << first;
@@ -909,6 +935,7 @@ TEST_P(HardCasesHalfSize, FiniteFrameSizedAndWithinWhatTheUpscaleCanGive)
 {
     const HardCase& c = std::get<0>(GetParam());
     LensSettings lens = baseLens();
+    applyAperture(std::get<1>(GetParam()), lens);
     QualitySettings quality = namedQuality(std::get<1>(GetParam()));
     ASSERT_EQ(quality.resolution, Resolution::Half);
     if (c.setup)
@@ -922,9 +949,10 @@ TEST_P(HardCasesHalfSize, FiniteFrameSizedAndWithinWhatTheUpscaleCanGive)
     ASSERT_EQ(linear.size(), c.size);
     ASSERT_TRUE(test::allFinite(linear));
 
-    // The frame's CoC, as upscale.frag computes it from the filled depth; pixels within 1 % of the
-    // 2 px edge count as under it (the shader's float maths may round the other way).
-    const CocCoefficients k = cocCoefficients(lens, c.size.width);
+    // The frame's CoC, as upscale.frag computes it from the filled depth (the gather's: the lens'
+    // scaled to the aperture's area); pixels within 1 % of the 2 px edge count as under it (the
+    // shader's float maths may round the other way).
+    const CocCoefficients k = scaled(cocCoefficients(lens, c.size.width), gatherScale(ApertureShape::of(lens)));
     const cv::Mat& depth = pipeline.filledDepth();
     cv::Mat blurred(c.size, CV_8U);
     for (int y = 0; y < c.size.height; ++y)
@@ -958,6 +986,12 @@ INSTANTIATE_TEST_SUITE_P(EveryCase, HardCases,
 INSTANTIATE_TEST_SUITE_P(EveryCase, HardCasesHalfSize,
                          ::testing::Combine(::testing::ValuesIn(kCases), ::testing::Values("balanced", "fast")),
                          caseName);
+// Other apertures: their sprites and the gather's scaled CoC on every hostile input.
+INSTANTIATE_TEST_SUITE_P(EveryAperture, HardCases,
+                         ::testing::Combine(::testing::ValuesIn(kCases), ::testing::Values("rhombi_circle", "high_nonagon")),
+                         caseName);
+INSTANTIATE_TEST_SUITE_P(EveryAperture, HardCasesHalfSize,
+                         ::testing::Combine(::testing::ValuesIn(kCases), ::testing::Values("balanced_oval")), caseName);
 
 // The blur's two discrete steps, each measured alone on a uniform CoC D (focal range, every
 // depth beyond the far limit, so c = max-coc everywhere and the bleeding rule never acts):

@@ -1,14 +1,17 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Bokeh sprites (HighlightSpritePass, highlight_sprites.comp, highlight_sprite.vert/.frag): the
-// light of blurred pixels above white scattered as hexagons with exact edges, only on frames with
-// such lights.
+// light of blurred pixels above white scattered in the aperture's shape (any blade count, the circle,
+// squeezed) with exact edges, only on frames with such lights.
 #include <cmath>
 #include <cstdio>
+#include <numbers>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "bench/methods/ReferenceScatter.hpp"
+#include "filter/Aperture.hpp"
 #include "filter/Pipeline.hpp"
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"
@@ -84,6 +87,105 @@ TEST_F(HighlightSprites, ALightBecomesAHexagonWithExactEdgesAndAllItsEnergy)
                 rmsWithout);
     EXPECT_LT(rms, 0.5 * rmsWithout) << "the sprites' edges are sharper than the gather's";
 }
+
+/// The share of each pixel of a `size` frame that the aperture `lens` (blades, rotation, ratio) of
+/// circumradius `radius` centred at `centre` covers, behind the focus: drawn 16 times as large
+/// with OpenCV from its corners (at the rotation + pi / n + 2 pi k / n, counter-clockwise, y up,
+/// as Cycles' regular_polygon_sample() places them; x divided by the ratio) or as an ellipse, and
+/// averaged down. Independent of filter/Aperture.cpp, which works from the edges' normals.
+cv::Mat supersampledAperture(const LensSettings& lens, cv::Size size, cv::Point2d centre, double radius)
+{
+    constexpr int kScale = 16, kShift = 4; // fillPoly's fixed point: 4 fractional bits
+    cv::Mat big(size * kScale, CV_8U, cv::Scalar(0));
+    const auto fixed = [](double v) { return static_cast<int>(std::lround(v * kScale * (1 << kShift))); };
+    // Pixel (x, y) spans [x, x + 1) x [y, y + 1); the big image's sample (X, Y) sits at (X + 0.5) / 16.
+    const double cx = centre.x * kScale - 0.5, cy = centre.y * kScale - 0.5;
+    const double rx = radius * kScale / lens.apertureRatio, ry = radius * kScale;
+    if (lens.blades == 0) {
+        cv::ellipse(big, cv::Point(fixed(cx / kScale), fixed(cy / kScale)),
+                    cv::Size(fixed(rx / kScale), fixed(ry / kScale)), 0.0, 0.0, 360.0, cv::Scalar(255), cv::FILLED,
+                    cv::LINE_8, kShift);
+    } else {
+        std::vector<cv::Point> corners;
+        for (int k = 0; k < lens.blades; ++k) {
+            const double angle = lens.bladeRotationDeg * std::numbers::pi / 180.0 + std::numbers::pi / lens.blades +
+                                 2.0 * std::numbers::pi * k / lens.blades;
+            corners.emplace_back(fixed((cx + rx * std::cos(angle)) / kScale), fixed((cy - ry * std::sin(angle)) / kScale));
+        }
+        cv::fillPoly(big, std::vector<std::vector<cv::Point>>{corners}, cv::Scalar(255), cv::LINE_8, kShift);
+    }
+    cv::Mat coverage;
+    big.convertTo(big, CV_64F, 1.0 / 255.0);
+    cv::resize(big, coverage, size, 0, 0, cv::INTER_AREA);
+    return coverage;
+}
+
+struct ApertureCase {
+    const char* name;
+    int blades;
+    double rotationDeg, ratio;
+};
+void PrintTo(const ApertureCase& c, std::ostream* os)
+{
+    *os << c.name;
+}
+
+class ApertureSprites : public HighlightSprites, public ::testing::WithParamInterface<ApertureCase> {};
+
+// Defect caught: a light drawn in the wrong shape (the hexagon whatever the blades, a polygon
+// turned or squeezed the wrong way, the circle's radius off by the gather's scale), or its energy
+// lost or doubled (an area that is not the shape's, or sprites and gather both keeping it).
+TEST_P(ApertureSprites, ALightBecomesTheApertureWithExactEdgesAndAllItsEnergy)
+{
+    const ApertureCase& c = GetParam();
+    const double diameter = 30.0;
+    const cv::Mat color = light({48, 48}, 1000.0f);
+    const cv::Mat far(color.size(), CV_32F, cv::Scalar(2.0f));
+    LensSettings lens = test::lensWithFarCoc(diameter);
+    lens.blades = c.blades;
+    lens.bladeRotationDeg = c.rotationDeg;
+    lens.apertureRatio = c.ratio;
+    Pipeline pipeline;
+    const cv::Mat out = pipeline.run({color, far, 0.0, 0, "light"}, lens, quality(true), View::Composite,
+                                     Encoding::Linear32F);
+    EXPECT_TRUE(pipeline.plan().highlightSprites);
+    cv::Mat gray, gray64;
+    cv::cvtColor(out, gray, cv::COLOR_BGR2GRAY);
+    gray.convertTo(gray64, CV_64F);
+    EXPECT_NEAR(cv::sum(gray)[0], 1000.0, 5.0); // float sums over ~700 pixels, 0.5 %
+
+    cv::Mat exact = supersampledAperture(lens, gray.size(), {48.5, 48.5}, diameter / 2.0);
+    const double area = cv::sum(exact)[0];
+    // The shape's area from its own formula: what the gather's scale and the sprites divide by.
+    EXPECT_NEAR(area, apertureArea(ApertureShape::of(lens)) * diameter * diameter / 4.0, 0.01 * area);
+    exact *= 1000.0 / area;
+    const double plateau = 1000.0 / area;
+    cv::Mat difference;
+    cv::absdiff(gray64, exact, difference);
+    double worst = 0.0;
+    cv::minMaxLoc(difference, nullptr, &worst);
+    const double rms = std::sqrt(cv::mean(difference.mul(difference))[0]) / plateau;
+    std::printf("[ FIGURE   ] %s: worst %.3f, rms %.4f of the plateau\n", c.name, worst / plateau, rms);
+    // The sprite's ramp on the distance to the nearest edge covers half of a pixel centred on a
+    // corner, where a corner of angle theta covers theta / 2 pi of it: 0.5 - theta / 2 pi worst
+    // (0.33 for the triangle, 0.17 for the hexagon, 0 for the circle); the reference's 1/16 px
+    // raster moves its edges by up to 1/16 of a pixel's coverage; 0.01 for float sums. A shape
+    // turned by half a blade, or scaled by the gather's factor, puts whole pixels of plateau
+    // wrong (worst ~1). RMS: a quarter of the gather's alone on the hexagon (0.042, above).
+    const double corner = c.blades == 0 ? 0.0 : 0.5 - (c.blades - 2.0) / (2.0 * c.blades);
+    EXPECT_LT(worst / plateau, corner + 1.0 / 16.0 + 0.01);
+    EXPECT_LT(rms, 0.042 / 4.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryShape, ApertureSprites,
+                         ::testing::Values(ApertureCase{"hexagon", 6, 0.0, 1.0}, ApertureCase{"circle", 0, 0.0, 1.0},
+                                           ApertureCase{"triangle", 3, 0.0, 1.0}, ApertureCase{"pentagon", 5, 0.0, 1.0},
+                                           ApertureCase{"heptagon_turned_15", 7, 15.0, 1.0},
+                                           ApertureCase{"octagon", 8, 0.0, 1.0}, ApertureCase{"nonagon", 9, 0.0, 1.0},
+                                           ApertureCase{"sixteen", 16, 0.0, 1.0},
+                                           ApertureCase{"oval_tall", 0, 0.0, 2.0},
+                                           ApertureCase{"pentagon_wide", 5, 10.0, 0.6}),
+                         [](const ::testing::TestParamInfo<ApertureCase>& p) { return p.param.name; });
 
 TEST_F(HighlightSprites, ALightFillingAThirdOfItsNeighbourhoodMakesSprites)
 {
