@@ -8,7 +8,7 @@
 # and gegl (Debian 12 packages; for measuring only, not to build defocus), or only the one named
 # with --tool.
 # Apertures (data/corpus-apertures/): Blender's node draws the scene's blades where it has them
-# (disk, 3 to 8 blades; 9 and more get its disk) at the orientation of Cycles' bokeh behind the
+# (disk, 3 to 8 blades; 9 to 11 get its octagon, 12 and more its disk) at the orientation of Cycles' bokeh behind the
 # focus, and no aperture ratio (blender_defocus.py); GEGL's lens-blur draws a disk whatever the
 # aperture.
 #   scripts/corpus/anchors.py [--out out/corpus_anchors] [--tool gegl|blender] SCENE_OR_CORPUS_DIR...
