@@ -332,8 +332,9 @@ PROBES = {"aperture-probe": scene_aperture_probe}
 
 # The apertures data/corpus-apertures/ holds, each on the bases listed: spheres-far-focus has
 # lights in front of the focus over a sharp background (depth edges), spheres-near-focus lights
-# both in front of the focus and behind it (the two orientations of an odd blade count).
-VARIANT_BASES = ["spheres-far-focus", "spheres-near-focus"]
+# both in front of the focus and behind it (the two orientations of an odd blade count),
+# overlapping-lights bokeh over bokeh at other depths, railing-lights thin bars over lights.
+VARIANT_BASES = ["spheres-far-focus", "spheres-near-focus", "overlapping-lights", "railing-lights"]
 VARIANT_APERTURES = ["circle", "5blades", "8blades", "9blades", "7blades-rot15", "circle-ratio2"]
 VARIANTS = [f"{base}--{aperture}" for base in VARIANT_BASES for aperture in VARIANT_APERTURES]
 
