@@ -7,7 +7,12 @@
 # Both get the CoC of the truth's camera (thinlens.py, the filter's thin-lens model). Needs blender
 # and gegl (Debian 12 packages; for measuring only, not to build defocus), or only the one named
 # with --tool.
+# Apertures (data/corpus-apertures/): Blender's node draws the scene's blades where it has them
+# (disk, 3 to 8 blades; 9 to 11 get its octagon, 12 and more its disk) at the orientation of Cycles' bokeh behind the
+# focus, and no aperture ratio (blender_defocus.py); GEGL's lens-blur draws a disk whatever the
+# aperture.
 #   scripts/corpus/anchors.py [--out out/corpus_anchors] [--tool gegl|blender] SCENE_OR_CORPUS_DIR...
+#   scripts/corpus/anchors.py data/corpus-apertures        # the aperture variants
 import argparse
 import json
 import os
@@ -83,12 +88,18 @@ def main():
 
             if "blender" in tools:
                 start = time.time()
-                subprocess.run(["nice", "-n", "19", "blender", "-b", "--factory-startup", "--python",
-                                os.path.join(HERE, "blender_defocus.py"), "--", scene_dir,
-                                os.path.join(out, "blender-defocus.exr"), str(radius * 1.2)],
-                               check=True, stdout=subprocess.DEVNULL)
-                timings.append(f"blender {time.time() - start:.1f} s")
-            print(f"anchors.py: {name}: max CoC radius {radius:.0f} px; " + ", ".join(timings))
+                done = subprocess.run(["nice", "-n", "19", "blender", "-b", "--factory-startup",
+                                       "--python-exit-code", "1", "--python",
+                                       os.path.join(HERE, "blender_defocus.py"), "--", scene_dir,
+                                       os.path.join(out, "blender-defocus.exr"), str(radius * 1.2)],
+                                      check=True, stdout=subprocess.PIPE, text=True)
+                said = [line for line in done.stdout.splitlines() if line.startswith("blender_defocus.py:")]
+                timings.append(f"blender {time.time() - start:.1f} s" + (f" ({said[-1][20:]})" if said else ""))
+            lens = meta["lens"]
+            aperture = ("disk" if lens.get("blades", 6) == 0 else f"{lens.get('blades', 6)} blades") + (
+                f" at {lens.get('bladeRotationDeg', 0.0):g} deg" if lens.get("blades", 6) else "") + (
+                f", ratio {lens['apertureRatio']:g} (neither tool has one)" if lens.get("apertureRatio", 1.0) != 1.0 else "")
+            print(f"anchors.py: {name}: {aperture}; max CoC radius {radius:.0f} px; " + ", ".join(timings))
 
 
 if __name__ == "__main__":

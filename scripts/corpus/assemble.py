@@ -13,7 +13,10 @@
 # PSNR(seed a, seed b) + 6.02 dB from the converged image (linear values clipped to [0, 1], the
 # benchmark's measure; clipping makes this an estimate). Also given for the lights zone alone
 # (within 30 px of a pinhole pixel above white), where nearly all of the noise is.
-#   scripts/corpus/assemble.py RAW_DIR OUT_DIR [--samples-per-seed N]
+# A variant (scenes.py: BASE--APERTURE, the base's scene through another aperture) is assembled
+# with --base BASE_SCENE_DIR: its folder holds only truth_linear.exr and a scene.json that names
+# the base's colour and depth by their paths relative to it (the pinhole images are the base's).
+#   scripts/corpus/assemble.py RAW_DIR OUT_DIR [--base BASE_SCENE_DIR]
 import argparse
 import glob
 import json
@@ -53,6 +56,7 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("raw")
     parser.add_argument("out")
+    parser.add_argument("--base", help="a variant's base scene folder: its colour and depth are used, not copied")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
     meta = json.load(open(os.path.join(args.raw, "lens.json")))
@@ -60,12 +64,26 @@ def main():
     render = json.load(open(os.path.join(args.raw, "render.json"))) if os.path.exists(
         os.path.join(args.raw, "render.json")) else {}
 
-    colour = read(os.path.join(args.raw, "color_linear.exr"))
-    depth = read(os.path.join(args.raw, "depth.exr"))
-    if depth.ndim == 3:
-        depth = depth[..., 0]
-    if depth.max() * 1000 > 65535:
-        sys.exit(f"assemble.py: {args.raw}: depth reaches {depth.max():.1f} m, beyond 65.535 m of 16-bit mm")
+    if args.base:
+        base = json.load(open(os.path.join(args.base, "scene.json")))
+        base_lens = {k: v for k, v in base["lens"].items() if k not in ("blades", "bladeRotationDeg", "apertureRatio")}
+        own_lens = {k: v for k, v in lens.items() if k not in ("blades", "bladeRotationDeg", "apertureRatio")}
+        if base_lens != own_lens:
+            sys.exit(f"assemble.py: {args.raw}: lens {own_lens} is not the base's {base_lens} but for the aperture")
+        colour = read(os.path.join(args.base, base["color"]))
+        # The pinhole is the base's: its files, named relative to the variant's folder.
+        color_path = os.path.relpath(os.path.join(args.base, base["color"]), args.out)
+        depth_path = os.path.relpath(os.path.join(args.base, base["depth"]), args.out)
+        depth_units = base.get("depthUnitsPerMetre", 1000)
+        render["pinholeSamples"] = base["render"].get("pinholeSamples")
+    else:
+        colour = read(os.path.join(args.raw, "color_linear.exr"))
+        depth = read(os.path.join(args.raw, "depth.exr"))
+        if depth.ndim == 3:
+            depth = depth[..., 0]
+        if depth.max() * 1000 > 65535:
+            sys.exit(f"assemble.py: {args.raw}: depth reaches {depth.max():.1f} m, beyond 65.535 m of 16-bit mm")
+        color_path, depth_path, depth_units = "color_linear.exr", "depth_mm.png", 1000
     seeds = sorted(glob.glob(os.path.join(args.raw, "truth_seed*.exr")))
     if len(seeds) < 2:
         sys.exit(f"assemble.py: {args.raw}: need at least two truth_seed*.exr renders, found {len(seeds)}")
@@ -80,18 +98,19 @@ def main():
     outside = cv2.distanceTransform(not_light, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) > 30.0
     outside_db = psnr_clipped(halves[0][outside], halves[1][outside]) + 10 * math.log10(2 * len(halves))
 
-    if not cv2.imwrite(os.path.join(args.out, "color_linear.exr"), rounded(colour), EXR_HALF):
-        sys.exit("assemble.py: cannot write color_linear.exr")
-    mm = np.clip(np.round(depth * 1000.0), 0, 65535).astype(np.uint16)
-    if not cv2.imwrite(os.path.join(args.out, "depth_mm.png"), mm, [cv2.IMWRITE_PNG_COMPRESSION, 9]):
-        sys.exit("assemble.py: cannot write depth_mm.png")
+    if not args.base:
+        if not cv2.imwrite(os.path.join(args.out, "color_linear.exr"), rounded(colour), EXR_HALF):
+            sys.exit("assemble.py: cannot write color_linear.exr")
+        mm = np.clip(np.round(depth * 1000.0), 0, 65535).astype(np.uint16)
+        if not cv2.imwrite(os.path.join(args.out, "depth_mm.png"), mm, [cv2.IMWRITE_PNG_COMPRESSION, 9]):
+            sys.exit("assemble.py: cannot write depth_mm.png")
     if not cv2.imwrite(os.path.join(args.out, "truth_linear.exr"), rounded(truth), EXR_HALF):
         sys.exit("assemble.py: cannot write truth_linear.exr")
     scene = {
         "description": meta["description"],
-        "color": "color_linear.exr",
-        "depth": "depth_mm.png",
-        "depthUnitsPerMetre": 1000,
+        "color": color_path,
+        "depth": depth_path,
+        "depthUnitsPerMetre": depth_units,
         "truth": "truth_linear.exr",
         "lens": lens,
         "render": {
@@ -105,11 +124,16 @@ def main():
             "truthEstimatedPsnrDbOutsideLights": round(outside_db, 2),
         },
     }
+    # Seconds each seed's render took (render.sh: niced, wall clock), where it noted them.
+    seconds = [os.path.splitext(s)[0] + ".seconds" for s in seeds]
+    if all(os.path.exists(s) for s in seconds):
+        scene["render"]["truthSecondsPerSeed"] = [int(open(s).read()) for s in seconds]
     with open(os.path.join(args.out, "scene.json"), "w") as f:
         json.dump(scene, f, indent=2)
         f.write("\n")
     print(f"assemble.py: {args.out}: truth from {len(halves)} seeds, seeds agree to {pair_db:.2f} dB, "
-          f"truth about {truth_db:.2f} dB from converged ({outside_db:.2f} outside the lights); depth {depth.min():.2f}-{depth.max():.2f} m")
+          f"truth about {truth_db:.2f} dB from converged ({outside_db:.2f} outside the lights)"
+          + ("" if args.base else f"; depth {depth.min():.2f}-{depth.max():.2f} m"))
 
 
 main()

@@ -6,12 +6,19 @@
 #       --scene portrait-50 --pass pinhole --samples 64 --out out/corpus_render/portrait-50
 #   ... --pass truth --samples 256 --seed 1 --out ...     (writes truth_seed1.exr)
 #   blender -b --python scripts/corpus/scenes.py -- --list      (scene names, one a line)
+# A scene name BASE--APERTURE is the scene BASE (same geometry, same pinhole colour and depth)
+# seen through another aperture, only its truth differs (data/corpus-apertures/): APERTURE is
+# "circle" or "<n>blades" (3..16), then optionally "-rot<degrees>" (blade rotation) and
+# "-ratio<r>" (anamorphic, Cycles' dof.aperture_ratio): spheres-far-focus--circle,
+# spheres-far-focus--7blades-rot15, spheres-far-focus--circle-ratio2.
+#   ... -- --list-variants   (the variants data/corpus-apertures/ holds, one a line)
 # Every scene is built from code below (no .blend file), so anyone can rerun and change it.
 import argparse
 import json
 import math
 import os
 import random
+import re
 import sys
 
 import bpy
@@ -297,6 +304,18 @@ def scene_near_object(rng):
     return lens
 
 
+def scene_aperture_probe(rng):
+    """Not a corpus scene (not listed): point-like lights on black, to see an aperture's shape and
+    which way it points. 85 mm f/1.4 focused at 3 m; lights at 1.5 m (in front of the focus: 31
+    px) on the left, at the focus in the middle, at 20 m (behind it: 26 px) on the right."""
+    lens = dict(focal_mm=85.0, f_number=1.4, focus_m=3.0, camera_z=1.0)
+    z = lens["camera_z"]
+    plane((0.0, 60.0, z), (200.0, 200.0), material("black", (0.0, 0.0, 0.0)), rotation=(math.pi / 2, 0.0, 0.0))
+    for d, x, y in [(1.5, 160, 160), (1.5, 160, 320), (3.0, 320, 240), (20.0, 480, 160), (20.0, 480, 320)]:
+        light(at_depth(d, x, y, lens, z), radius=0.0012 * d, strength=1000)
+    return lens
+
+
 SCENES = {
     "spheres-near-focus": scene_spheres_near_focus,
     "spheres-far-focus": scene_spheres_far_focus,
@@ -308,13 +327,73 @@ SCENES = {
     "near-object": scene_near_object,
 }
 
+# Scenes that scenes.py renders by name but does not --list: no part of the corpus.
+PROBES = {"aperture-probe": scene_aperture_probe}
+
+# The apertures data/corpus-apertures/ holds, each on the bases listed: spheres-far-focus has
+# lights in front of the focus over a sharp background (depth edges), spheres-near-focus lights
+# both in front of the focus and behind it (the two orientations of an odd blade count),
+# overlapping-lights bokeh over bokeh at other depths, railing-lights thin bars over lights.
+VARIANT_BASES = ["spheres-far-focus", "spheres-near-focus", "overlapping-lights", "railing-lights"]
+VARIANT_APERTURES = ["circle", "5blades", "8blades", "9blades", "7blades-rot15", "circle-ratio2"]
+VARIANTS = [f"{base}--{aperture}" for base in VARIANT_BASES for aperture in VARIANT_APERTURES]
+
+APERTURE_NAME = re.compile(r"^(circle|([0-9]+)blades)(-rot(-?[0-9]+(?:\.[0-9]+)?))?(-ratio([0-9]+(?:\.[0-9]+)?))?$")
+
+
+def parse_scene_name(name):
+    """(base scene, aperture) of a scene name BASE or BASE--APERTURE; the aperture is a dict of
+    blades (0 = a disk), rotation in degrees and ratio (Cycles' aperture_ratio)."""
+    base, sep, spec = name.partition("--")
+    aperture = dict(blades=6, rotation_deg=0.0, ratio=1.0)  # the corpus' own (data/corpus/)
+    if sep:
+        m = APERTURE_NAME.match(spec)
+        if not m:
+            raise ValueError(f"{name}: aperture '{spec}' is not circle or <n>blades, [-rot<deg>], [-ratio<r>]")
+        aperture["blades"] = 0 if m.group(1) == "circle" else int(m.group(2))
+        if aperture["blades"] != 0 and not 3 <= aperture["blades"] <= 16:
+            raise ValueError(f"{name}: Cycles draws 3 to 16 blades (or circle), not {aperture['blades']}")
+        aperture["rotation_deg"] = float(m.group(4) or 0.0)
+        aperture["ratio"] = float(m.group(6) or 1.0)
+        if aperture["ratio"] <= 0.0:
+            raise ValueError(f"{name}: the aperture ratio must be positive")
+    if base not in SCENES and base not in PROBES:
+        raise ValueError(f"{name}: no scene '{base}' (--list)")
+    return base, aperture
+
+
+def describe_aperture(aperture):
+    shape = "a disk" if aperture["blades"] == 0 else f"{aperture['blades']} blades"
+    if aperture["blades"] != 0:
+        shape += f" at rotation {aperture['rotation_deg']:g} deg"
+    if aperture["ratio"] != 1.0:
+        shape += f", anamorphic: aperture ratio {aperture['ratio']:g} (Cycles scales the lens' x by 1/{aperture['ratio']:g})"
+    return shape
+
+
+def lens_meta(lens, aperture):
+    meta = {
+        "focalLengthMm": lens["focal_mm"],
+        "sensorWidthMm": SENSOR_WIDTH_MM,
+        "fNumber": lens["f_number"],
+        "focusM": lens["focus_m"],
+        "blades": aperture["blades"],
+        "bladeRotationDeg": aperture["rotation_deg"],
+    }
+    if aperture["ratio"] != 1.0:
+        meta["apertureRatio"] = aperture["ratio"]
+    meta["fieldOfView"] = "focal-length"
+    return meta
+
+
 # ---- render -------------------------------------------------------------------------------------
 
 
 def setup(name, render_pass, samples, seed, adaptive=None):
+    base, aperture = parse_scene_name(name)
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    lens = SCENES[name](random.Random(name))
+    lens = {**SCENES, **PROBES}[base](random.Random(base))  # a variant is its base's geometry, random parts too
 
     world = bpy.data.worlds.new("world")
     world.use_nodes = True
@@ -336,8 +415,9 @@ def setup(name, render_pass, samples, seed, adaptive=None):
     cam_data.dof.use_dof = render_pass == "truth"
     cam_data.dof.focus_distance = lens["focus_m"]
     cam_data.dof.aperture_fstop = lens["f_number"]
-    cam_data.dof.aperture_blades = 6
-    cam_data.dof.aperture_rotation = 0.0
+    cam_data.dof.aperture_blades = aperture["blades"]
+    cam_data.dof.aperture_rotation = math.radians(aperture["rotation_deg"])
+    cam_data.dof.aperture_ratio = aperture["ratio"]
     cam = bpy.data.objects.new("camera", cam_data)
     cam.location = (0.0, 0.0, lens["camera_z"])
     cam.rotation_euler = (math.pi / 2, 0.0, 0.0)  # looks along +y: planar depth = y
@@ -395,14 +475,15 @@ def setup(name, render_pass, samples, seed, adaptive=None):
         slot.format.exr_codec = "ZIP"
         slot.format.color_mode = "RGB"  # one channel is kept when the scene folder is assembled
         tree.links.new(layers.outputs["Depth"], files.inputs["depth"])
-    return lens, files, stem
+    return lens, aperture, files, stem
 
 
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     parser = argparse.ArgumentParser(prog="scenes.py")
     parser.add_argument("--list", action="store_true", help="print the scene names and exit")
-    parser.add_argument("--scene", choices=sorted(SCENES))
+    parser.add_argument("--list-variants", action="store_true", help="print the aperture variants' names and exit")
+    parser.add_argument("--scene", help="a scene (--list) or BASE--APERTURE")
     parser.add_argument("--pass", dest="render_pass", choices=["pinhole", "truth"], default="pinhole")
     parser.add_argument("--samples", type=int, default=64)
     parser.add_argument("--seed", type=int, default=0)
@@ -414,12 +495,21 @@ def main():
     if args.list:
         print("\n".join(SCENES))
         return
+    if args.list_variants:
+        print("\n".join(VARIANTS))
+        return
     if not args.scene or not args.out:
         parser.error("--scene and --out are required")
+    try:
+        base, aperture = parse_scene_name(args.scene)
+    except ValueError as error:
+        parser.error(str(error))
+    if base != args.scene and args.render_pass == "pinhole":
+        parser.error(f"{args.scene}: a variant's pinhole is its base's ({base}); render that")
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     adaptive = (args.adaptive[0], int(args.adaptive[1])) if args.adaptive else None
-    lens, files, stem = setup(args.scene, args.render_pass, args.samples, args.seed, adaptive)
+    lens, aperture, files, stem = setup(args.scene, args.render_pass, args.samples, args.seed, adaptive)
     scene = bpy.context.scene
     if args.threads > 0:
         scene.render.threads_mode = "FIXED"
@@ -431,19 +521,12 @@ def main():
     # The file output node appends the frame number; drop it.
     for s in [stem] + (["depth"] if args.render_pass == "pinhole" else []):
         os.replace(os.path.join(out, f"{s}0001.exr"), os.path.join(out, f"{s}.exr"))
-    if args.render_pass == "pinhole":
-        meta = {
-            "focalLengthMm": lens["focal_mm"],
-            "sensorWidthMm": SENSOR_WIDTH_MM,
-            "fNumber": lens["f_number"],
-            "focusM": lens["focus_m"],
-            "blades": 6,
-            "bladeRotationDeg": 0.0,
-            "fieldOfView": "focal-length",
-        }
-        description = " ".join(SCENES[args.scene].__doc__.split())
-        with open(os.path.join(out, "lens.json"), "w") as f:
-            json.dump({"lens": meta, "description": description}, f, indent=2)
+    # The lens, for the scene folder (assemble.py): the pinhole's folder and every truth's.
+    description = " ".join({**SCENES, **PROBES}[base].__doc__.split())
+    if base != args.scene:
+        description += f" The same scene through another aperture than data/corpus' 6 blades: {describe_aperture(aperture)}."
+    with open(os.path.join(out, "lens.json"), "w") as f:
+        json.dump({"lens": lens_meta(lens, aperture), "description": description}, f, indent=2)
     print(f"scenes.py: wrote {args.render_pass} of {args.scene} ({args.samples} samples, seed {args.seed}) to {out}")
 
 
