@@ -66,7 +66,9 @@ for scene in "$@"; do
             seed_start=$(date +%s)
             $BLENDER --scene "$scene" --pass truth --samples "$SAMPLES" --seed "$seed" --out "$raw" \
                 ${ADAPTIVE:+--adaptive $ADAPTIVE} \
-                >"$raw/truth_seed$seed.log" 2>&1
+                >"$raw/truth_seed$seed.log" 2>&1 ||
+                { echo "render.sh: $scene: truth render failed ($raw/truth_seed$seed.log):" >&2
+                  tail -n 1 "$raw/truth_seed$seed.log" >&2; exit 1; }
             echo $(($(date +%s) - seed_start)) >"$raw/truth_seed$seed.seconds"  # niced, wall clock
         fi
         seed=$((seed + 1))
