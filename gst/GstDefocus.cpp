@@ -1409,7 +1409,7 @@ static void gst_defocus_class_init(GstDefocusClass* klass)
 
     gst_element_class_set_static_metadata(
         element, "Depth of field", "Filter/Effect/Video",
-        "Gives colour + depth video the depth of field of a real lens, with hexagonal bokeh (OpenGL 4.5, headless EGL)",
+        "Gives colour + depth video the depth of field of a real lens, with the bokeh of a real aperture (OpenGL 4.5, headless EGL)",
         "defocus developers");
     gst_element_class_add_static_pad_template(element, &srcTemplate);
     gst_element_class_add_static_pad_template_with_gtype(element, &colorTemplate, GST_TYPE_VIDEO_AGGREGATOR_CONVERT_PAD);
@@ -1450,5 +1450,5 @@ static gboolean plugin_init(GstPlugin* plugin)
 
 #define PACKAGE "defocus"
 GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, defocus,
-                  "Depth of field with hexagonal bokeh for colour + depth video", plugin_init, DEFOCUS_VERSION,
+                  "Depth of field with polygonal or round bokeh for colour + depth video", plugin_init, DEFOCUS_VERSION,
                   "LGPL", "defocus", "the defocus source tree (no public URL)")

@@ -228,7 +228,7 @@ void addQualityOptions(CLI::App& app, Quality& quality, QualityNames& names)
     app.add_flag("--near-field,!--no-near-field", names.nearField,
                  "Spread blurred foreground over what is behind it [default: from --quality]");
     app.add_flag("--highlight-sprites,!--no-highlight-sprites", quality.highlightSprites,
-                 "Rhombi: lights brighter than white scatter as hexagons with exact edges (bokeh sprites) "
+                 "Rhombi: lights brighter than white scatter in the aperture's shape with exact edges (bokeh sprites) "
                  "[default: on]")
         ->capture_default_str();
     app.add_option("--highlight-gain", quality.highlightGain,

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// defocus: gives recorded RGB-D footage the depth of field of a real lens, with hexagonal bokeh.
+// defocus: gives recorded RGB-D footage the depth of field of a real lens, with polygonal or round bokeh.
 //   defocus data/tum_fr1_rpy -o out/tum.mp4 --focus 1.2 --f-number 1.4
 //   defocus photo.png --depth depth.png --depth-scale 1000 -o out.png --view coc
 //   defocus --info
@@ -941,7 +941,7 @@ int runBatchCommand(const Options& global, const std::vector<std::string>& argum
 int main(int argc, char** argv)
 {
     Options o;
-    CLI::App app{"defocus: depth of field with hexagonal bokeh for RGB-D images and clips (McIntosh et al. 2012).\n"
+    CLI::App app{"defocus: depth of field with the bokeh of a real aperture (hexagonal by default) for RGB-D images and clips (McIntosh et al. 2012).\n"
                  "INPUT is a TUM RGB-D folder (rgb.txt + depth.txt), a folder of colour images (with --depth "
                  "FOLDER), one colour image (with --depth FILE), a video file (with --depth FILE, FOLDER or "
                  "depth.txt) or a V4L2 camera /dev/videoN (with --depth FILE or a Z16 camera); --demo needs none.\n"

@@ -44,7 +44,7 @@ print(f"--focal-length {lens['focalLengthMm']} --f-number {n} --focus {s} --sens
 PY
 )
 apertures=("hexagon:--blades 6" "circle:--blades 0" "9 blades:--blades 9" "7 blades at 15 deg:--blades 7 --blade-rotation 15"
-           "oval 2:1:--blades 0 --aperture-ratio 2")
+           "oval, ratio 2:--blades 0 --aperture-ratio 2")
 declare -A times
 for round in $(seq "$rounds"); do
   for entry in "${apertures[@]}"; do
@@ -57,12 +57,12 @@ for round in $(seq "$rounds"); do
   done
 done
 echo "# $(date -u +%FT%TZ), $(git -C "$root" rev-parse --short HEAD), $size, $frames frames x $rounds rounds, $preset, $(basename "$scene")"
-echo "| aperture | ms per frame (median of $rounds) | vs the hexagon |"
-echo "|---|---:|---:|"
+echo "| aperture | ms per frame (median of $rounds) | vs the hexagon | each round |"
+echo "|---|---:|---:|---|"
 median() { tr ' ' '\n' | grep -v '^$' | sort -n | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 hexagon=$(echo "${times[hexagon]}" | median)
 for entry in "${apertures[@]}"; do
   name=${entry%%:*}
   ms=$(echo "${times[$name]}" | median)
-  printf '| %s | %.1f | %.2f |\n' "$name" "$ms" "$(echo "$ms / $hexagon" | bc -l)"
+  printf '| %s | %.1f | %.2f | %s|\n' "$name" "$ms" "$(echo "$ms / $hexagon" | bc -l)" "${times[$name]}"
 done

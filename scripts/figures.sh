@@ -34,6 +34,8 @@ sections=(
   "soak|10,000 frames: memory and GL objects (README Stability)|$build/defocus-soak --frames 10000"
   "gst-gl|the defocus element's frames per second in system and in GL memory, 640x480, no display (docs/gstreamer.md)|env -u DISPLAY -u WAYLAND_DISPLAY scripts/gst-gl-fps.sh $build 200"
   "gst-gl-1080|the same at 1920x1080 (docs/gstreamer.md)|env -u DISPLAY -u WAYLAND_DISPLAY scripts/gst-gl-fps.sh $build 30 1920x1080"
+  "apertures-accuracy|the presets against the truths through other apertures (docs/accuracy.md Apertures; anchors from scripts/corpus/anchors.py --out out/corpus_anchors data/corpus-apertures, where present)|$build/defocus-bench-accuracy --scene data/corpus-apertures --anchors out/corpus_anchors --output $out/accuracy-apertures"
+  "apertures-cost|ms per frame of the circle, 9 blades, a turned 7 and an oval beside the hexagon's, 640x480 and 1920x1080 (docs/accuracy.md Apertures)|scripts/aperture-cost.sh $build data/corpus/spheres-far-focus 640x480 20 3 && scripts/aperture-cost.sh $build data/corpus/spheres-far-focus 1920x1080 10 3"
 )
 
 field() { cut -d'|' -f"$2" <<<"$1"; }
