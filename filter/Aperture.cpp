@@ -26,11 +26,22 @@ double apertureArea(const ApertureShape& shape)
     return unit / static_cast<double>(shape.ratio);
 }
 
+GatherSqueeze gatherSqueeze(const ApertureShape& shape)
+{
+    // The aperture's width is divided by the ratio: (1 / ratio, 1), over the larger.
+    if (shape.ratio >= 1.0f)
+        return {1.0f / shape.ratio, 1.0f};
+    return {1.0f, shape.ratio};
+}
+
 float gatherScale(const ApertureShape& shape)
 {
     if (shape.isHexagon())
         return 1.0f;
-    return static_cast<float>(std::sqrt(apertureArea(shape) / kHexagonArea));
+    // The squeezed hexagon of circumradius k R covers k^2 x y 3 sqrt(3) / 2 R^2; the aperture
+    // covers apertureArea() R^2 (its own squeeze included).
+    const GatherSqueeze squeeze = gatherSqueeze(shape);
+    return static_cast<float>(std::sqrt(apertureArea(shape) / (kHexagonArea * squeeze.x * squeeze.y)));
 }
 
 ApertureEdges apertureEdges(const ApertureShape& shape)

@@ -2,7 +2,7 @@
 // The aperture's shape, as Blender Cycles samples it: a regular polygon of `blades` corners on the
 // circle of the aperture's diameter (or that circle), rotated, its width divided by the
 // anamorphic ratio. Lights scatter with its exact edges (the bokeh sprites); the gather of
-// everything else is the rhombi's hexagon, scaled to the aperture's area.
+// everything else is the rhombi's hexagon, squeezed as the aperture is and scaled to its area.
 #pragma once
 
 #include <array>
@@ -26,9 +26,18 @@ struct ApertureShape {
 /// pi for the circle, divided by the ratio.
 double apertureArea(const ApertureShape& shape);
 
-/// The factor the gather's CoC is scaled by so that its hexagon (area 3 sqrt(3) / 2 R^2) covers
-/// the aperture's area: what a light spreads over is then the aperture's, and the blur's
-/// spread (its second moment) is within 0.4 % of a circle's. Exactly 1 for the hexagon.
+/// How the gather's hexagon is squeezed, in the image's axes: the aperture's squeeze (its
+/// width divided by the ratio) over its larger factor, so that neither exceeds 1 and no line
+/// reaches beyond the gather's CoC radius (gatherScale() holds the rest). {1, 1} unsqueezed.
+struct GatherSqueeze {
+    float x = 1.0f, y = 1.0f;
+};
+GatherSqueeze gatherSqueeze(const ApertureShape& shape);
+
+/// The factor the gather's CoC is scaled by so that its hexagon (area 3 sqrt(3) / 2 R^2),
+/// squeezed by gatherSqueeze(), covers the aperture's area: what a light spreads over is then
+/// the aperture's, and the blur's spread (its second moment) is within 0.4 % of a circle's.
+/// Exactly 1 for the hexagon.
 float gatherScale(const ApertureShape& shape);
 
 /// The sprites' edges (aperture.glsl), in pixels with y down the rows: for each edge k < 16, the

@@ -182,6 +182,7 @@ struct Pipeline::Impl {
     QualitySettings quality;
     float bladeRotationDeg = 0.0f; ///< the gather's hexagon's
     ApertureShape aperture;
+    RhombusBlurPass::Directions directions{}; ///< the rhombi's: rotated and squeezed as the aperture is
     SceneAnalysis analysis;
     FramePlan plan;
     bool rendered = false;
@@ -298,6 +299,8 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     // The gather's hexagon: the lens' for a hexagonal aperture; for other shapes a corner on top,
     // whose lines lie on the axes (a rotated hexagon's off-axis lines cost llvmpipe 8x as much).
     p.bladeRotationDeg = p.aperture.isHexagon() ? static_cast<float>(lens.bladeRotationDeg) : 0.0f;
+    const GatherSqueeze squeeze = gatherSqueeze(p.aperture);
+    p.directions = RhombusBlurPass::directions(p.bladeRotationDeg, squeeze.x, squeeze.y);
     const CocCoefficients lensCoc = cocCoefficients(lens, p.size.width);
     p.coefficients = scaled(lensCoc, gatherScale(p.aperture));
     p.maxCocPx = lensCoc.maxCocPx;
@@ -445,7 +448,6 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
         uploadNearDiameter();
         near = &nearDiameter;
     }
-    const auto directions = RhombusBlurPass::directions(bladeRotationDeg);
     const TileList* tiles = useTiles ? &blurTiles : nullptr;
     timer.begin("rhombi-1");
     rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, directions, quality.samples, tileSize(), tiles,
@@ -466,7 +468,7 @@ void Pipeline::Impl::rhombiSecondPass(const gl::Framebuffer* fusedTarget)
     glBindVertexArray(vao.id());
     timer.begin("rhombi-2");
     rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, target}, false,
-                        RhombusBlurPass::directions(bladeRotationDeg), quality.samples, tileSize(), tiles,
+                        directions, quality.samples, tileSize(), tiles,
                         fusedTarget != nullptr, plan.unrolledTaps);
     if (rhombiUsesTiles)
         copyPass.run(horizontal.texture, copyTiles, target, fusedTarget == nullptr);
@@ -611,7 +613,7 @@ Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, f
         p.inFocusLightPass.run({p.colorTexture, p.depth, p.coc.texture, p.plan.nearField ? &p.nearDiameter : nullptr},
                                CocPass::uniforms(p.coefficients, half, static_cast<float>(p.plan.highlightGain),
                                                  HighlightSpritePass::kThreshold),
-                               RhombusBlurPass::directions(p.bladeRotationDeg), p.quality.samples, p.tileSize(),
+                               p.directions, p.quality.samples, p.tileSize(),
                                p.blurShift, p.frameHighlightTiles, out.framebuffer);
         p.timer.end();
     }

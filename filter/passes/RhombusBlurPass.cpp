@@ -124,7 +124,7 @@ const gl::Program& RhombusBlurPass::program(bool first, bool near, bool tiles, L
     return slot;
 }
 
-RhombusBlurPass::Directions RhombusBlurPass::directions(float bladeRotationDeg)
+RhombusBlurPass::Directions RhombusBlurPass::directions(float bladeRotationDeg, float squeezeX, float squeezeY)
 {
     // Any corner can be u1 (the three rhombi from alternate corners cover the same hexagon):
     // take the one nearest an axis, so that at rotations in steps of 30 deg the first line is
@@ -139,15 +139,34 @@ RhombusBlurPass::Directions RhombusBlurPass::directions(float bladeRotationDeg)
             u1 = corner;
         }
     }
-    return {u1, u1 + 120.0f, u1 + 240.0f};
+    Directions d{u1, u1 + 120.0f, u1 + 240.0f};
+    if (squeezeX == 1.0f && squeezeY == 1.0f)
+        return d;
+    // Squeezed, a corner at angle a moves to (squeezeX cos a, squeezeY sin a): the rhombi spanned
+    // by the squeezed corners make the squeezed hexagon, and each line runs that far along its
+    // new direction per pixel of radius. An axis stays an axis.
+    float* corners[] = {&d.u1, &d.u2, &d.u3};
+    for (int k = 0; k < 3; ++k) {
+        const double a = *corners[k] * std::numbers::pi / 180.0;
+        const double x = squeezeX * std::cos(a), y = squeezeY * std::sin(a);
+        d.lengths[k] = static_cast<float>(std::hypot(x, y));
+        *corners[k] = static_cast<float>(std::atan2(y, x) * 180.0 / std::numbers::pi);
+    }
+    return d;
 }
 
 RhombusBlurPass::Lines RhombusBlurPass::lines(const Directions& d, int width, int height)
 {
     const LineModes modes = lineModes(d);
-    const auto line = [&](float degrees, LineMode mode, bool pair) {
+    const float angles[] = {d.u1, d.u2, d.u3};
+    const auto line = [&](int corner, LineMode mode, bool pair) {
+        const float degrees = angles[corner];
         Line l{};
         step(degrees, width, height, l.direction, l.baseStep);
+        // A squeezed corner: the line moves lengths[corner] pixels per pixel of radius.
+        l.direction[0] *= d.lengths[corner];
+        l.direction[1] *= d.lengths[corner];
+        l.baseStep /= d.lengths[corner];
         if (pair)
             halfPixelAcross(degrees, width, height, l.across);
         l.mode = mode;
@@ -155,11 +174,11 @@ RhombusBlurPass::Lines RhombusBlurPass::lines(const Directions& d, int width, in
     };
     // u3's two lines share their offsets: either one taking pairs sets them for both.
     const bool u3Pair = modes.second[1] == LineMode::Pair || modes.second[2] == LineMode::Pair;
-    return {line(d.u1, modes.first[0], modes.first[0] == LineMode::Pair),
-            line(d.u2, modes.first[1], modes.first[1] == LineMode::Pair),
-            line(d.u2, modes.second[0], modes.second[0] == LineMode::Pair),
-            line(d.u3, modes.second[1], u3Pair),
-            line(d.u3, modes.second[2], u3Pair)};
+    return {line(0, modes.first[0], modes.first[0] == LineMode::Pair),
+            line(1, modes.first[1], modes.first[1] == LineMode::Pair),
+            line(1, modes.second[0], modes.second[0] == LineMode::Pair),
+            line(2, modes.second[1], u3Pair),
+            line(2, modes.second[2], u3Pair)};
 }
 
 void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int taps, int tileSize,

@@ -28,17 +28,20 @@ public:
 
     /// The directions of one hexagon, degrees counter-clockwise on screen: u1 towards the corner
     /// nearest an axis, u2 = u1 + 120, u3 = u1 + 240. `bladeRotationDeg` 0 puts a corner on top
-    /// (u1 = 90); 30 a flat edge (u1 = 0).
+    /// (u1 = 90); 30 a flat edge (u1 = 0). A hexagon squeezed by `squeezeX` and `squeezeY` (each
+    /// at most 1: an anamorphic aperture's, gatherSqueeze() in filter/Aperture.hpp) has its
+    /// corners along the squeezed directions, `lengths` times as far (pixels per pixel of radius).
     struct Directions {
         float u1, u2, u3;
+        float lengths[3] = {1.0f, 1.0f, 1.0f};
     };
-    static Directions directions(float bladeRotationDeg);
+    static Directions directions(float bladeRotationDeg, float squeezeX = 1.0f, float squeezeY = 1.0f);
 
     /// How a line takes its taps (rhombus_lines.glsl): unfiltered, bilinear, or a bilinear pair.
     enum class LineMode { Point = 0, Smooth = 1, Pair = 2 };
-    /// One line at a target's size: texture-space offset per pixel along it, half a pixel across
-    /// it (Pair lines only, else 0), the step that moves one pixel on its major axis (pixels),
-    /// and how it takes its taps.
+    /// One line at a target's size: texture-space offset per pixel of radius along it, half a
+    /// pixel across it (Pair lines only, else 0), the step that moves one pixel on its major axis
+    /// (pixels of radius: pixels, unless the hexagon is squeezed), and how it takes its taps.
     struct Line {
         float direction[2];
         float across[2];
