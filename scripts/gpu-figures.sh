@@ -58,7 +58,12 @@ case ${1:-} in
     step info "$unpacked/bin/defocus" --info
     step throughput "$unpacked/bin/defocus-bench" throughput --sizes "$sizes" --frames "$frames" --passes 3
     step passes "$unpacked/bin/defocus-bench" --sizes "$sizes" --runs "$frames" --warmup 5 --json "$out/bench.json"
-    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json"
+    # The apertures beside the hexagon (needs python3-opencv there to make the frames).
+    for size in 1920x1080 3840x2160; do
+      step "apertures-$size" scripts/aperture-cost.sh "$unpacked/bin" data/corpus/spheres-far-focus "$size" 20 3 ||
+        echo "gpu-figures: apertures at $size not measured (see $out/apertures-$size.txt)"
+    done
+    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, apertures-*.txt"
     ;;
   *)
     echo "usage: scripts/gpu-figures.sh pack [BUILD_DIR] | run [OUT_DIR]" >&2
