@@ -4,6 +4,7 @@
 // the status (drawn by sinks/DisplaySink, DisplaySinkTest.cpp).
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -54,6 +55,37 @@ TEST(PreviewControls, ImpossibleFNumbersAreClampedWithAWarning)
     ASSERT_EQ(outcome.issues.size(), 1u);
     // A step inside the range says nothing.
     EXPECT_TRUE(applyKey(controls, '+', 2.0).issues.empty());
+}
+
+// Defect: an aperture key that skips a blade count or lands outside 0 and 3..16, a turn of the
+// wrong size, an oval that cannot be undone, or a change the picture does not redraw for.
+TEST(PreviewControls, BRAndOChangeTheAperture)
+{
+    LiveControls controls; // 6 blades
+    std::vector<int> seen;
+    for (int i = 0; i < 15; ++i) {
+        const auto revision = controls.revision;
+        const auto outcome = applyKey(controls, 'b', 2.0);
+        EXPECT_TRUE(outcome.handled);
+        EXPECT_GT(controls.revision, revision);
+        seen.push_back(controls.lens.blades);
+    }
+    EXPECT_EQ(seen, (std::vector<int>{7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 0, 3, 4, 5, 6}));
+    EXPECT_EQ(applyKey(controls, 'b', 2.0).message, "aperture: 7 blades");
+    applyKey(controls, 'r', 2.0);
+    EXPECT_DOUBLE_EQ(controls.lens.bladeRotationDeg, 15.0);
+    for (int i = 0; i < 11; ++i)
+        applyKey(controls, 'r', 2.0);
+    EXPECT_DOUBLE_EQ(controls.lens.bladeRotationDeg, 180.0);
+    applyKey(controls, 'r', 2.0);
+    EXPECT_DOUBLE_EQ(controls.lens.bladeRotationDeg, -165.0); // stays in [-180, 180]
+    EXPECT_EQ(applyKey(controls, 'o', 2.0).message, "aperture: 7 blades -165 deg, ratio 2");
+    EXPECT_DOUBLE_EQ(controls.lens.apertureRatio, 2.0);
+    applyKey(controls, 'o', 2.0);
+    EXPECT_DOUBLE_EQ(controls.lens.apertureRatio, 1.0);
+    Settings settings;
+    settings.lens = controls.lens;
+    EXPECT_TRUE(check(settings).empty());
 }
 
 TEST(PreviewControls, BracketsChangeMaxCocAndClampAtZero)
