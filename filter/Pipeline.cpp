@@ -379,6 +379,7 @@ void Pipeline::Impl::prepareDepthAndPlan()
     setBlurShift(plan.blurShift);
     plan.highlightGain = highlightGain;
     plan.highlightSprites = sprites;
+    plan.gatherScale = gatherScale(aperture);
     plan.allInFocus = plan.allInFocus || allInFocus;
 }
 

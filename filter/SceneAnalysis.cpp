@@ -286,8 +286,8 @@ std::string FramePlan::explain(const SceneAnalysis& analysis) const
                                                 analysis.maxAbsCoc())
                                   : fmt::format("coc, blur {} on {}/{} tiles (copy {}), composite; CoC {:+.1f}..{:+.1f} px",
                                                 kernel == HexagonKernel::RhombiSum ? "rhombi x2" : "mcintosh x3",
-                                                blurTiles.size(), total, copyTiles.size(), analysis.minCoc,
-                                                analysis.maxCoc);
+                                                blurTiles.size(), total, copyTiles.size(),
+                                                analysis.minCoc / gatherScale, analysis.maxCoc / gatherScale);
     if (allInFocus)
         return text + " (hole filling and analysis skipped)";
     if (blurShift != 0)

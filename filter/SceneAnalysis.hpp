@@ -123,6 +123,9 @@ struct FramePlan {
     /// Rhombi: the blur loops unrolled to the tap count, because most blurred tiles have lines
     /// that long (rhombus_blur.frag UNROLLED); otherwise plain loops that stop at each line's end.
     bool unrolledTaps = false;
+    /// The analysis' CoC (the gather's) over the lens': gatherScale() of the aperture, set by the
+    /// pipeline; explain() reports the lens' CoC.
+    float gatherScale = 1.0f;
 
     /// One line for --explain, e.g. "blur 812/1200 tiles, copy 388; hole fill on (24.1 % invalid)".
     std::string explain(const SceneAnalysis& analysis) const;

@@ -156,5 +156,21 @@ TEST(ScenePlan, TapLoopsUnrollWhereMostLinesRunToTheLastTap)
     EXPECT_FALSE(makePlan(analysis, true, HexagonKernel::RhombiSum, Resolution::Full).unrolledTaps);
 }
 
+// Defect: --explain reporting the gather's CoC (the lens' scaled to a round aperture's area, 1.1
+// times as large for the circle) as the lens' blur.
+TEST(ScenePlan, ExplainReportsTheLensCoc)
+{
+    SceneAnalysis analysis;
+    analysis.tiles = {2, 1};
+    analysis.minCoc = -44.0f;
+    analysis.maxCoc = 5.5f;
+    FramePlan plan;
+    plan.kernel = HexagonKernel::RhombiSum;
+    plan.blurTiles = {{0, 0}, {1, 0}};
+    plan.gatherScale = 1.1f;
+    const std::string text = plan.explain(analysis);
+    EXPECT_NE(text.find("CoC -40.0..+5.0 px"), std::string::npos) << text;
+}
+
 } // namespace
 } // namespace defocus

@@ -67,10 +67,13 @@ compare headless
 
 # 2. An X display (Xvfb), where GStreamer opens its own (GLX).
 if command -v Xvfb >/dev/null; then
-  for n in $(seq 90 130); do [ -e /tmp/.X$n-lock ] || break; done
-  Xvfb ":$n" -screen 0 1024x768x24 -nolisten tcp >/dev/null 2>&1 &
+  # The server picks a free display and writes its number when it listens (-displayfd): tests
+  # that start their own Xvfb side by side cannot take the same one.
+  Xvfb -displayfd 3 -screen 0 1024x768x24 -nolisten tcp 3>"$work/display" >/dev/null 2>&1 &
   xvfb=$!
-  for _ in $(seq 50); do [ -e "/tmp/.X11-unix/X$n" ] && break; sleep 0.1; done
+  for _ in $(seq 100); do [ -s "$work/display" ] && break; sleep 0.1; done
+  n=$(head -n 1 "$work/display")
+  [ -n "$n" ] || { echo "gl-memory-test: Xvfb did not start" >&2; exit 1; }
   (export DISPLAY=":$n"; unset WAYLAND_DISPLAY; run xvfb gl)
   compare xvfb
 else
