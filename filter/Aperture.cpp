@@ -2,7 +2,6 @@
 // The aperture's shape: its area, the gather's scale, the sprites' edges.
 #include "filter/Aperture.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -47,7 +46,6 @@ float gatherScale(const ApertureShape& shape)
 ApertureEdges apertureEdges(const ApertureShape& shape)
 {
     ApertureEdges out;
-    out.ratio = shape.ratio;
     if (shape.isCircle())
         return out;
     // Cycles samples the polygon with an edge's normal at the rotation (x right, y up) and its
@@ -67,26 +65,6 @@ ApertureEdges apertureEdges(const ApertureShape& shape)
     }
     out.count = shape.blades;
     return out;
-}
-
-float apertureCoverage(const ApertureShape& shape, float offsetX, float offsetY, float radius, bool near)
-{
-    const ApertureEdges e = apertureEdges(shape);
-    const float x = near ? -offsetX : offsetX, y = near ? -offsetY : offsetY;
-    float distance = 0.0f;
-    if (e.count == 0) {
-        // The ellipse x^2 ratio^2 + y^2 = R^2: the distance of its level set, to first order.
-        const float sx = x * e.ratio, level = std::hypot(sx, y);
-        const float gradient = level > 0.0f ? std::hypot(sx * e.ratio, y) / level : 1.0f;
-        distance = (level - radius) / gradient;
-    } else {
-        distance = -radius;
-        for (int k = 0; k < e.count; ++k)
-            distance = k == 0 ? x * e.edges[0] + y * e.edges[1] - radius * e.edges[2]
-                              : std::max(distance, x * e.edges[4 * k] + y * e.edges[4 * k + 1] -
-                                                       radius * e.edges[4 * k + 2]);
-    }
-    return std::clamp(0.5f - distance, 0.0f, 1.0f);
 }
 
 } // namespace defocus

@@ -40,20 +40,13 @@ GatherSqueeze gatherSqueeze(const ApertureShape& shape);
 /// Exactly 1 for the hexagon.
 float gatherScale(const ApertureShape& shape);
 
-/// The sprites' edges (aperture.glsl), in pixels with y down the rows: for each edge k < 16, the
-/// unit normal (x, y) and the distance of the edge from the centre per pixel of circumradius;
-/// `count` edges, 0 for the circle, whose squeeze is `ratio`.
+/// The sprites' edges (aperture_sprite.glsl), in pixels with y down the rows: for each edge
+/// k < 16, the unit normal (x, y) and the distance of the edge from the centre per pixel of
+/// circumradius; `count` edges, 0 for the circle.
 struct ApertureEdges {
     std::array<float, 4 * 16> edges{}; ///< (nx, ny, distance per radius, 0) per edge
     int count = 0;
-    float ratio = 1.0f;
 };
 ApertureEdges apertureEdges(const ApertureShape& shape);
-
-/// The share of the pixel at `offsetX`, `offsetY` (pixels from the centre, y down) that the
-/// shape of circumradius `radius` covers, behind the focus (`near`: in front of it, where the
-/// image of the aperture is turned by 180 degrees), with half a pixel of ramp either side of the
-/// edge: aperture.glsl's apertureCoverage() on the CPU, for tests.
-float apertureCoverage(const ApertureShape& shape, float offsetX, float offsetY, float radius, bool near);
 
 } // namespace defocus

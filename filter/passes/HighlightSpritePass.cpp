@@ -62,7 +62,7 @@ void HighlightSpritePass::updateSpriteParams(const gl::Texture& depth, const Ape
     SpriteParams params{};
     params.frameSize[0] = static_cast<float>(depth.width());
     params.frameSize[1] = static_cast<float>(depth.height());
-    params.ratio = edges.ratio;
+    params.ratio = shape.ratio;
     params.edgeCount = edges.count;
     params.nearField = nearField ? 1 : 0;
     params.gatherScale = gatherScale(shape);
