@@ -182,6 +182,7 @@ struct Pipeline::Impl {
     QualitySettings quality;
     float bladeRotationDeg = 0.0f; ///< the gather's hexagon's
     ApertureShape aperture;
+    float gatherScale = 1.0f; ///< gatherScale(aperture): the gather's CoC over the lens'
     RhombusBlurPass::Directions directions{}; ///< the rhombi's: rotated and squeezed as the aperture is
     SceneAnalysis analysis;
     FramePlan plan;
@@ -302,7 +303,8 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
     const GatherSqueeze squeeze = gatherSqueeze(p.aperture);
     p.directions = RhombusBlurPass::directions(p.bladeRotationDeg, squeeze.x, squeeze.y);
     const CocCoefficients lensCoc = cocCoefficients(lens, p.size.width);
-    p.coefficients = scaled(lensCoc, gatherScale(p.aperture));
+    p.gatherScale = gatherScale(p.aperture);
+    p.coefficients = scaled(lensCoc, p.gatherScale);
     p.maxCocPx = lensCoc.maxCocPx;
     p.frameIndex = frame.index;
     p.fallbackDepth = std::isinf(lens.focusM) ? 1e6f : static_cast<float>(lens.focusM);
@@ -379,7 +381,7 @@ void Pipeline::Impl::prepareDepthAndPlan()
     setBlurShift(plan.blurShift);
     plan.highlightGain = highlightGain;
     plan.highlightSprites = sprites;
-    plan.gatherScale = gatherScale(aperture);
+    plan.gatherScale = gatherScale;
     plan.allInFocus = plan.allInFocus || allInFocus;
 }
 
@@ -596,7 +598,7 @@ Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, f
         } else if (view == View::Coc) {
             // The lens' CoC in the target's pixels; the target holds the gather's.
             high = p.maxCocPx / static_cast<float>(1 << p.blurShift);
-            p.viewPass.run(p.coc.texture, ViewPass::Mode::Coc, 0.0f, high * gatherScale(p.aperture), out.framebuffer);
+            p.viewPass.run(p.coc.texture, ViewPass::Mode::Coc, 0.0f, high * p.gatherScale, out.framebuffer);
         } else {
             p.viewPass.run(p.target(view).texture, ViewPass::Mode::Color, 0.0f, 0.0f, out.framebuffer);
         }

@@ -7,7 +7,8 @@
 // directional blurs and the min() of two), at full or half size (half: a prefilter and an upscale
 // that puts the frame's in-focus pixels back), bokeh sprites for lights above white in the
 // aperture's exact shape (any blade count, the circle, squeezed: filter/Aperture.hpp; the gather's
-// hexagon covers the aperture's area), and the view read back. Owns every intermediate target and reallocates them only when size or format changes.
+// hexagon is squeezed as the aperture is and covers its area), and the view read back. Owns every
+// intermediate target and reallocates them only when size or format changes.
 // Needs a current GL 4.5 context (gl::EglContext) for its whole life.
 #pragma once
 
