@@ -215,9 +215,12 @@ struct Filter::Impl {
     /// report from the pipeline's last frame, frame number `index`.
     void fillReport(std::size_t index) { fillReport(index, pipeline->timings(), report); }
     void fillReport(std::size_t index, const FrameTimings& t, FrameReport& r) const;
-    /// The frame process() and submit() filter from the caller's images, and its lens (the
+    /// The frame process(), submit() and processTextures() filter from the caller's images, and its lens (the
     /// autofocus stepped); throws InputError and SettingsError as process() documents.
     Frame admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens);
+    /// admit() and the frame's passes on the pipeline (whose context must be current); the frame
+    /// and its lens kept for the report.
+    void processFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
     /// submit() without its check: the frame's passes run, its read queued into inFlight.
     void submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
     /// receive() of a frame in flight (there must be one).
@@ -458,15 +461,20 @@ std::vector<Timings::Pass> Filter::finishGpuTimings()
     return out;
 }
 
-void Filter::Impl::submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+void Filter::Impl::processFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
 {
     LensSettings frameLens;
     Frame frame = admit(color, depth, timestampS, frameLens);
-    const auto bound = current();
     pipeline->process(frame, frameLens, quality);
-    InFlight entry{pipeline->readAsync(toView(settings.view), toEncoding(settings.output)), {}};
     lastFrame = std::move(frame);
     lastLens = frameLens;
+}
+
+void Filter::Impl::submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+{
+    const auto bound = current();
+    processFrame(color, depth, timestampS);
+    InFlight entry{pipeline->readAsync(toView(settings.view), toEncoding(settings.output)), {}};
     fillReport(frames++, entry.read.timings(), entry.report);
     inFlight.push_back(std::move(entry));
 }
@@ -585,13 +593,9 @@ void Filter::processTextures(const GlFrame& frame, double timestampS)
     } catch (const gl::ContextError& error) {
         throw InputError(error.what());
     }
-    LensSettings lens;
-    Frame admitted = p.admit(color, depth, timestampS, lens);
+    p.processFrame(color, depth, timestampS);
     // The result stays on the GPU, in the caller's texture.
-    p.pipeline->process(admitted, lens, p.quality);
     p.pipeline->readInto(toView(p.settings.view), frame.output, frame.outputOrder == GlFrame::Order::Bgra);
-    p.lastFrame = std::move(admitted);
-    p.lastLens = lens;
     p.fillReport(p.frames++);
 }
 
