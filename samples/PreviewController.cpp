@@ -85,6 +85,7 @@ KeyOutcome applyKey(LiveControls& controls, int key, double focusM)
     outcome.handled = true;
     Lens& lens = controls.lens;
     bool lensChanged = false;
+    bool apertureChanged = false; // always valid: no check, the message names it
     switch (key) {
     case '1': case '2': case '3': case '4': case '5': case '6': case '7':
         controls.view = kViews[key - '1'];
@@ -112,15 +113,15 @@ KeyOutcome applyKey(LiveControls& controls, int key, double focusM)
         break;
     case 'b':
         lens.blades = nextBlades(lens.blades);
-        outcome.message = "aperture: " + apertureText(lens);
+        apertureChanged = true;
         break;
     case 'r':
         lens.bladeRotationDeg = std::remainder(lens.bladeRotationDeg + 15.0, 360.0);
-        outcome.message = "aperture: " + apertureText(lens);
+        apertureChanged = true;
         break;
     case 'o':
         lens.apertureRatio = lens.apertureRatio == 1.0 ? 2.0 : 1.0;
-        outcome.message = "aperture: " + apertureText(lens);
+        apertureChanged = true;
         break;
     case 'm':
         lens.cocModel = lens.cocModel == Lens::Model::ThinLens ? Lens::Model::FocalRange : Lens::Model::ThinLens;
@@ -150,6 +151,8 @@ KeyOutcome applyKey(LiveControls& controls, int key, double focusM)
         outcome.handled = false;
         return outcome;
     }
+    if (apertureChanged)
+        outcome.message = "aperture: " + apertureText(lens);
     if (lensChanged) {
         // Judge the new values on the lens they will be used with, and keep the clamped ones.
         const Lens used = lensFor(controls, focusM, &outcome.issues);
