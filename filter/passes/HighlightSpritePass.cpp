@@ -72,7 +72,8 @@ void HighlightSpritePass::updateSpriteParams(const gl::Texture& depth, const Ape
     // degrees + the rotation, counter-clockwise on screen (y runs down the rows); for other
     // shapes the hexagon around the circle 0.71 px beyond their circumradius (that much
     // further where the squeeze widens them), corner up.
-    const double corner = shape.isHexagon() ? (90.0 + shape.rotationDeg) * std::numbers::pi / 180.0 : std::numbers::pi / 2;
+    const double corner =
+        shape.isHexagon() ? (90.0 + shape.rotationDeg) * std::numbers::pi / 180.0 : std::numbers::pi / 2;
     params.fanCorner[0] = static_cast<float>(std::cos(corner));
     params.fanCorner[1] = static_cast<float>(-std::sin(corner));
     const float toCorner = shape.isHexagon() ? 1.0f : 1.0f / std::cos(static_cast<float>(std::numbers::pi) / 6.0f);

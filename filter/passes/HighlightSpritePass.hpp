@@ -32,8 +32,9 @@ public:
     /// Step 1, before the CoC pass: finds the sprites in `color` (sRGB8 or float RGB) and `depth`
     /// (R32F metres, filled) with the CoC pass' settings (`k`, the gather's CoC, `highlightGain`,
     /// `largestColor`, the tiles' `neighbourhoods`, SceneAnalysis::tileNeighbourhood) and the
-    /// aperture's (`shape`, whose gatherScale() `k` holds, `nearField`), at most `budget` of them; a frame with more draws none, and the CoC pass (reading sprites())
-    /// then keeps all of their light. Only the 16x16 `tiles` (SceneAnalysis::highlightTiles) are
+    /// aperture's (`shape`, whose gatherScale() `k` holds, `nearField`), at most `budget` of them;
+    /// a frame with more draws none, and the CoC pass (reading sprites()) then keeps all of their
+    /// light. Only the 16x16 `tiles` (SceneAnalysis::highlightTiles) are
     /// searched: no pixel elsewhere is bright enough.
     void find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, float highlightGain,
               float largestColor, const ApertureShape& shape, bool nearField, const gl::StorageBuffer& neighbourhoods,
