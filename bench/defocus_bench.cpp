@@ -70,6 +70,9 @@ struct Options : cli::QualityNames {
     /// off: the path before quarter size), in a second pipeline, frame by frame alternating with
     /// the first: before and after as a ratio within one run.
     bool versusHalfOnly = false;
+    /// Also time the defocused scene with depth prep and the scene measurement on the CPU
+    /// (Pipeline::prepareOnGpu off), in a second pipeline, frames alternating as above.
+    bool versusCpuPrep = false;
     std::string json;
 };
 
@@ -241,6 +244,15 @@ CocSpread cocSpread(const std::vector<Frame>& frames, const LensSettings& lens)
     return spread;
 }
 
+/// CPU time the calling thread has used, milliseconds: what a frame costs it besides waiting
+/// (the driver's own threads, llvmpipe's rasteriser among them, are not counted).
+double threadCpuMs()
+{
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
 Series& seriesNamed(std::vector<Series>& all, const std::string& key, const std::string& label)
 {
     for (Series& series : all)
@@ -277,7 +289,7 @@ std::vector<SceneResult> measure(const std::vector<Variant>& variants, std::size
 
     struct Collected {
         SceneResult result;
-        std::vector<double> gpuSum, depthPrep, analysis, upload, render, readback, total;
+        std::vector<double> gpuSum, depthPrep, analysis, upload, render, readback, total, thread;
         double cpuSeconds = 0.0, othersSeconds = 0.0;
     };
     std::vector<Collected> collected(variants.size());
@@ -295,7 +307,9 @@ std::vector<SceneResult> measure(const std::vector<Variant>& variants, std::size
     const CpuClock cpuStart = CpuClock::now();
     for (int i = 0; i < options.runs; ++i)
         for (std::size_t v = 0; v < variants.size(); ++v) {
+            const double threadStart = threadCpuMs();
             runFrame(variants[v], options.warmup + i);
+            collected[v].thread.push_back(threadCpuMs() - threadStart);
             const FrameTimings& t = variants[v].pipeline->timings();
             Collected& c = collected[v];
             c.result.quarterFrames += variants[v].pipeline->plan().blurShift == 2 ? 1 : 0;
@@ -322,8 +336,9 @@ std::vector<SceneResult> measure(const std::vector<Variant>& variants, std::size
         result.othersCpuShare = othersShare;
         if (!c.gpuSum.empty())
             result.gpu.push_back({"sum", "GPU sum of passes", c.gpuSum});
-        result.wall = {{"depthPrep", "depth prep (CPU)", c.depthPrep},
-                       {"analysis", "scene analysis (CPU)", c.analysis},
+        result.wall = {{"callingThreadCpu", "calling thread's CPU", c.thread},
+                       {"depthPrep", "depth prep (submit or CPU)", c.depthPrep},
+                       {"analysis", "analysis + plan (wall)", c.analysis},
                        {"upload", "upload (wall)", c.upload},
                        {"renderSubmit", "render submit (wall)", c.render},
                        {"readback", "readback (wall)", c.readback},
@@ -428,6 +443,11 @@ int run(const Options& options, const std::string& commandLine)
         versusPipeline.emplace(!options.noTimers);
         versusPipeline->finishEachPass(options.finishEachPass);
         versusScene = "half only";
+    } else if (options.versusCpuPrep) {
+        versusPipeline.emplace(!options.noTimers);
+        versusPipeline->finishEachPass(options.finishEachPass);
+        versusPipeline->prepareOnGpu(false);
+        versusScene = "CPU depth prep";
     }
 
     const unsigned cores = std::thread::hardware_concurrency();
@@ -451,6 +471,9 @@ int run(const Options& options, const std::string& commandLine)
     if (options.versusHalfOnly)
         fmt::print("versus: the defocused scene also always at half size (no quarter size on large blur: the path "
                    "before it), in a second pipeline, frames alternating between the two\n");
+    if (options.versusCpuPrep)
+        fmt::print("versus: the defocused scene also with depth prep and the scene measurement on the CPU, the "
+                   "filled depth uploaded, in a second pipeline, frames alternating between the two\n");
     fmt::print("GPU = {}{}; wall = CPU clock; readback waits for the GPU to finish.\n"
                "Sizes other than the clip's are resized from it (aspect not kept); a row of n/a: the pass did "
                "not run.\nother processes' CPU %: share of all cores other programs used during the runs; "
@@ -541,6 +564,7 @@ int run(const Options& options, const std::string& commandLine)
               {"adaptive", quality.adaptive},
               {"finishEachPass", options.finishEachPass},
               {"versusHalfOnly", options.versusHalfOnly},
+              {"versusCpuPrep", options.versusCpuPrep},
               {"quarterOnLargeBlur", quality.quarterOnLargeBlur},
               {"focusM", options.focusM},
               {"fNumber", options.fNumber},
@@ -687,9 +711,13 @@ int main(int argc, char** argv)
     app.add_flag("--quarter-on-large-blur", o.quarterOnLargeBlur,
                  "Half size goes to quarter size on frames whose blur is mostly beyond 32 px and that have no "
                  "bokeh sprites (off in the presets: docs/benchmarks.md)");
-    app.add_flag("--versus-half-only", o.versusHalfOnly,
+    auto* halfOnly = app.add_flag("--versus-half-only", o.versusHalfOnly,
                  "Also time the defocused scene always at half size (quarter size on large blur off: the path "
                  "before it), frames alternating with the main settings', and print the ratio of frame times");
+    app.add_flag("--versus-cpu-prep", o.versusCpuPrep,
+                 "Also time the defocused scene with depth prep and the scene measurement on the CPU (the "
+                 "filled depth uploaded), frames alternating with the GPU's, and print the ratio of frame times")
+        ->excludes(halfOnly);
     app.add_flag("--finish-each-pass", o.finishEachPass,
                  "Profiling: glFinish before and after each pass, and wall ms per pass instead of timer queries "
                  "(llvmpipe renders at a flush, so its queries need not fall on the pass that was issued)");

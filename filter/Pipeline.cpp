@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <string_view>
 
 #include <epoxy/gl.h>
 #include <opencv2/imgproc.hpp>
@@ -21,10 +22,12 @@
 #include "filter/passes/CocPass.hpp"
 #include "filter/passes/CompositePass.hpp"
 #include "filter/passes/CopyPass.hpp"
+#include "filter/passes/DepthPrepPass.hpp"
 #include "filter/passes/HexBlurPass.hpp"
 #include "filter/passes/HighlightSpritePass.hpp"
 #include "filter/passes/InFocusLightPass.hpp"
 #include "filter/passes/RhombusBlurPass.hpp"
+#include "filter/passes/SceneMeasurePass.hpp"
 #include "filter/passes/NearBlurPass.hpp"
 #include "filter/passes/OutputCopyPass.hpp"
 #include "filter/passes/UpscalePass.hpp"
@@ -77,10 +80,13 @@ struct TargetPair {
     }
 };
 
-void ensureTexture(gl::Texture& texture, GLenum format, cv::Size size, const char* name)
+/// Makes `texture` anew unless it has `format` and `size`; true when it did.
+bool ensureTexture(gl::Texture& texture, GLenum format, cv::Size size, const char* name)
 {
-    if (!texture || texture.format() != format || texture.width() != size.width || texture.height() != size.height)
-        texture = gl::Texture(format, size.width, size.height, name);
+    if (texture && texture.format() == format && texture.width() == size.width && texture.height() == size.height)
+        return false;
+    texture = gl::Texture(format, size.width, size.height, name);
+    return true;
 }
 
 /// The range of valid depths in `depth` (any size); `lo`/`hi` unchanged when there is none.
@@ -116,10 +122,24 @@ double validDepthRange(const cv::Mat& depth, float& lo, float& hi)
     return depth.empty() ? 1.0 : static_cast<double>(invalid) / static_cast<double>(depth.total());
 }
 
+/// Mesa's software renderers. On llvmpipe, depth prep and the scene measurement cost more on
+/// its GPU than on the CPU: 8.7 and 34 ms a 640x480 frame against 1.5 and 1.3 (each pass's wall
+/// time, `defocus-bench --sizes 640x480 --versus-cpu-prep --finish-each-pass`), its fragment
+/// shaders paying 15 ns a pixel and its compute shaders' barriers more.
+bool softwareRenderer()
+{
+    const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const std::string_view renderer = name ? name : "";
+    return renderer.starts_with("llvmpipe") || renderer.starts_with("softpipe") ||
+           renderer.find("Software Rasterizer") != std::string_view::npos;
+}
+
 } // namespace
 
 struct Pipeline::Impl {
     gl::VertexArray vao = gl::VertexArray::create();
+    DepthPrepPass depthPrepPass;
+    SceneMeasurePass sceneMeasurePass;
     CocPass cocPass;
     HighlightSpritePass highlightSpritePass;
     InFocusLightPass inFocusLightPass;
@@ -140,7 +160,9 @@ struct Pipeline::Impl {
     gl::GpuTimer timer;
 
     gl::Texture colorTexture;
-    gl::Texture depth;
+    gl::Texture colorBytes;   ///< 8-bit frames: colorTexture's bytes, undecoded (SceneMeasurePass)
+    gl::Texture depthAsGiven; ///< the frame's depth as it came (prepareOnGpu)
+    gl::Texture depth;        ///< filled, the frame's size
     Target coc, horizontal, diagonalA, diagonalB, outSrgb, outLinear;
     // Rhombi: pass 1 writes X (horizontal) and Z (horizontalMean), pass 2 A and B (diagonalA/B).
     Target horizontalMean;
@@ -154,8 +176,15 @@ struct Pipeline::Impl {
     cv::Size size;     ///< the frame's
     cv::Size blurSize; ///< the blur passes': the frame's, or half or a quarter of it (Resolution::Half)
     int blurShift = 0; ///< log2 of size / blurSize (the plan's FramePlan::blurShift)
+    /// Depth prep and the scene measurement on the GPU (DepthPrepPass, SceneMeasurePass), or
+    /// on the CPU (prepareDepth(), measureScene()) with the filled depth uploaded: the CPU on a
+    /// software renderer (softwareRenderer()), the GPU on any other.
+    bool prepareOnGpu = !softwareRenderer();
+    /// The filled depth on the CPU: prepareDepth()'s, or read back from the GPU when asked for.
     PreparedDepth prepared;
+    bool preparedOnCpu = false; ///< `prepared` holds this frame's filled depth
     DepthPrepWorkspace depthWorkspace; // prepareDepth()'s buffers, kept from frame to frame
+    float nearestDepth = 0.0f, farthestDepth = 0.0f; ///< the filled depth's range (the depth view)
     float maxCocPx = 0.0f;
     FrameTimings timings;
     Clock::time_point frameStart;
@@ -217,6 +246,16 @@ struct Pipeline::Impl {
             rhombiSecondPass(nullptr);
     }
     void uploadNearDiameter();
+    /// The frame's colour into colorTexture (and its bytes' view).
+    void uploadColor()
+    {
+        const bool srgbInput = color.depth() == CV_8U;
+        if (ensureTexture(colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, size, "input colour"))
+            colorBytes = srgbInput ? gl::Texture::view(colorTexture, GL_RGB8, "input colour, bytes") : gl::Texture();
+        // BGRx goes up as it is: the texture has no alpha, so the fourth byte is dropped on the way.
+        colorTexture.upload(color.channels() == 4 ? GL_BGRA : GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT,
+                            color.data);
+    }
     void prepareDepthAndPlan();
     void setBlurShift(int shift)
     {
@@ -339,27 +378,62 @@ void Pipeline::process(const Frame& frame, const LensSettings& lens, const Quali
 void Pipeline::Impl::prepareDepthAndPlan()
 {
     // Depth: colour-sized, holes filled. With no depth at all, everything sits on the focus plane.
-    auto start = Clock::now();
-    prepareDepth(depthInput, size, fallbackDepth, depthWorkspace, prepared);
     // The rhombi's bokeh sprites take the light above white out of the gather; its edges go with
     // it (float frames only: 8-bit ones have nothing above white).
-    if (color.type() == CV_32FC3 && quality.kernel == HexagonKernel::RhombiSum && quality.highlightSprites)
-        putLightEdgesAtTheirLightsDepth(color, prepared.metres);
-    timings.depthPrepMs = msSince(start);
-    depthPrepared = true;
-    invalidFraction = prepared.invalidFraction;
-
-    start = Clock::now();
+    const bool lightEdges =
+        color.type() == CV_32FC3 && quality.kernel == HexagonKernel::RhombiSum && quality.highlightSprites;
     const bool srgbInput = color.depth() == CV_8U;
-    ensureTexture(depth, GL_R32F, size, "filled depth");
-    ensureTexture(colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, size, "input colour");
-    CV_Assert(color.isContinuous() && prepared.metres.isContinuous());
-    // BGRx goes up as it is: the texture has no alpha, so the fourth byte is dropped on the way.
-    colorTexture.upload(color.channels() == 4 ? GL_BGRA : GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT, color.data);
-    depth.upload(GL_RED, GL_FLOAT, prepared.metres.data);
-    timings.uploadMs = msSince(start);
+    CV_Assert(color.isContinuous() && (depthInput.empty() || depthInput.type() == CV_32FC1));
+    SceneMeasurement measurement;
+    auto start = Clock::now();
+    if (prepareOnGpu) {
+        // The frame's pixels go up as they came; only the measurement comes back.
+        uploadColor();
+        ensureTexture(depth, GL_R32F, size, "filled depth");
+        const cv::Mat given = depthInput.isContinuous() ? depthInput : depthInput.clone();
+        if (!given.empty()) {
+            ensureTexture(depthAsGiven, GL_R32F, given.size(), "depth as given");
+            depthAsGiven.upload(GL_RED, GL_FLOAT, given.data);
+        }
+        timings.uploadMs = msSince(start);
+        start = Clock::now();
+        glBindVertexArray(vao.id());
+        timer.begin(DepthPrepPass::kName);
+        depthPrepPass.run(given.empty() ? nullptr : &depthAsGiven, fallbackDepth, lightEdges ? &colorTexture : nullptr,
+                          depth);
+        timer.end();
+        timer.begin(SceneMeasurePass::kName);
+        sceneMeasurePass.run(depth, srgbInput ? colorBytes : colorTexture, srgbInput, coefficients,
+                             given.empty() ? nullptr : &depthPrepPass.measured());
+        timer.end();
+        timings.depthPrepMs = msSince(start);
+        std::size_t invalidPixels = 0;
+        measurement = sceneMeasurePass.read(invalidPixels);
+        invalidFraction = static_cast<double>(invalidPixels) / static_cast<double>(size.area());
+        preparedOnCpu = false;
+    } else {
+        prepareDepth(depthInput, size, fallbackDepth, depthWorkspace, prepared);
+        if (lightEdges)
+            putLightEdgesAtTheirLightsDepth(color, prepared.metres);
+        timings.depthPrepMs = msSince(start);
+        invalidFraction = prepared.invalidFraction;
+        preparedOnCpu = true;
 
-    analysis = analyseScene(prepared.metres, color, coefficients, prepared.invalidFraction);
+        start = Clock::now();
+        ensureTexture(depth, GL_R32F, size, "filled depth");
+        uploadColor();
+        CV_Assert(prepared.metres.isContinuous());
+        depth.upload(GL_RED, GL_FLOAT, prepared.metres.data);
+        timings.uploadMs = msSince(start);
+        measurement = measureScene(prepared.metres, color, coefficients);
+    }
+    depthPrepared = true;
+    double lo = 0.0, hi = 0.0;
+    cv::minMaxLoc(measurement.tileMinDepth, &lo);
+    cv::minMaxLoc(measurement.tileMaxDepth, nullptr, &hi);
+    nearestDepth = static_cast<float>(lo);
+    farthestDepth = static_cast<float>(hi);
+    analysis = finishAnalysis(measurement, coefficients, invalidFraction);
     const bool allInFocus = plan.allInFocus && quality.adaptive;
     // Highlights to treat: the plan's (FramePlan::highlights) on a frame not all in focus, which
     // makePlan() derives from the analysis alone, whatever size it picks.
@@ -590,10 +664,9 @@ Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, f
             p.ensureDiagonals();
         p.timer.begin(ViewPass::kName);
         if (view == View::Depth) {
-            double lo = 0.0, hi = 0.0;
-            cv::minMaxLoc(p.prepared.metres, &lo, &hi);
-            low = static_cast<float>(std::max(lo, 1e-3));
-            high = static_cast<float>(std::max(hi, lo * 1.01 + 1e-3));
+            const float lo = p.nearestDepth, hi = p.farthestDepth;
+            low = std::max(lo, 1e-3f);
+            high = std::max(hi, lo * 1.01f + 1e-3f);
             p.viewPass.run(p.depth, ViewPass::Mode::Depth, low, high, out.framebuffer);
         } else if (view == View::Coc) {
             // The lens' CoC in the target's pixels; the target holds the gather's.
@@ -813,9 +886,23 @@ cv::Mat Pipeline::readTarget(View view)
 
 const cv::Mat& Pipeline::filledDepth()
 {
-    if (!impl_->depthPrepared)
-        impl_->prepareDepthAndPlan();
-    return impl_->prepared.metres;
+    Impl& p = *impl_;
+    if (!p.depthPrepared)
+        p.prepareDepthAndPlan();
+    if (!p.preparedOnCpu) {
+        p.prepared.metres.create(p.size, CV_32FC1);
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glGetTextureImage(p.depth.id(), 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(p.prepared.metres.total() * 4),
+                          p.prepared.metres.data);
+        p.prepared.invalidFraction = p.invalidFraction;
+        p.preparedOnCpu = true;
+    }
+    return p.prepared.metres;
+}
+
+void Pipeline::prepareOnGpu(bool on)
+{
+    impl_->prepareOnGpu = on;
 }
 
 double Pipeline::invalidDepthFraction() const

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The depth-of-field pipeline for one frame: a frame whose valid depths all give less than half a
-// pixel of CoC is passed through before anything else; otherwise depth hole filling, upload, the
-// scene analysis (CPU) and the per-frame plan (which tiles blur, which are copied, whether
+// pixel of CoC is passed through before anything else; otherwise upload, depth hole filling and
+// the scene measurement (on the GPU, or on the CPU on a software renderer: prepareOnGpu()), the
+// analysis and the per-frame plan (which tiles blur, which are copied, whether
 // the near field, highlights and sprites run), the CoC pass, the blurs (QualitySettings::kernel:
 // two passes of one-sided lines summed into three rhombi, the default, or McIntosh et al.'s three
 // directional blurs and the min() of two), at full or half size (half: a prefilter and an upscale
@@ -39,8 +40,8 @@ struct PassTime {
 /// Where the time of the last frame went. Wall times are CPU-side; `gpu` comes from timer
 /// queries (empty when the driver has none).
 struct FrameTimings {
-    double depthPrepMs = 0.0; ///< resize + hole filling on the CPU
-    double analysisMs = 0.0;  ///< scene analysis + plan (CPU)
+    double depthPrepMs = 0.0; ///< resize + hole filling + measurement: submitting them, or on the CPU
+    double analysisMs = 0.0;  ///< waiting for the GPU's measurement, the analysis and the plan
     double uploadMs = 0.0;    ///< colour + depth to textures
     double renderMs = 0.0;    ///< submitting the passes
     double readbackMs = 0.0;  ///< output pass + glReadPixels (waits for the GPU)
@@ -122,6 +123,13 @@ public:
     /// renders when a flush or readback needs it, this is what puts each pass's cost on its
     /// own row; it removes the overlap of CPU and GPU work, so the frame is slower.
     void finishEachPass(bool on);
+
+    /// Depth prep (resize, hole filling, the lights' edges) and the scene measurement on the GPU,
+    /// the frame's depth uploaded as it came and only the measurement read back; or on the CPU,
+    /// the filled depth uploaded (prepareDepth(), measureScene()). The same filled depth and plan
+    /// either way (DepthPrepGLTest). The GPU by default, the CPU on a software renderer
+    /// (llvmpipe), where it is faster; tests and benchmarks hold the two side by side.
+    void prepareOnGpu(bool on);
 
     /// What the last frame called for, and what ran.
     const SceneAnalysis& analysis() const;

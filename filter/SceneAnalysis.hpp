@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // What a frame calls for: per-tile CoC range, a CoC histogram, foreground blur, highlights and
-// holes, measured on the CPU from the frame and its filled depth before they are uploaded. The
-// plan made from it decides which passes run where.
+// holes, measured from the frame and its filled depth (on the GPU by SceneMeasurePass, or on the
+// CPU by measureScene()). The plan made from it decides which passes run where.
 #pragma once
 
 #include <array>
@@ -82,10 +82,10 @@ struct SceneMeasurement {
 };
 
 /// Measures a frame from its filled depth (CV_32FC1 metres) and colour (CV_8UC3 sRGB or CV_32FC3
-/// linear, BGR), in bands of tile rows on OpenCV's threads. A compute pass per tile on llvmpipe,
-/// which the plan waited for, took longer: 12.6 against 8.7 ms for the analysis and plan of the
-/// TUM clip at 1920x1080, and 6.0 ms since the loops were made to vectorise (docs/benchmarks.md,
-/// "Sprites on their tiles, the analysis on the CPU").
+/// linear, BGR), in bands of tile rows on OpenCV's threads: the pipeline's measurement on a
+/// software renderer, where a compute pass per tile, which the plan waits for, took longer
+/// (SceneMeasurePass: 34 against 1.3 ms at 640x480 on llvmpipe; docs/benchmarks.md, "Sprites on
+/// their tiles, the analysis on the CPU").
 SceneMeasurement measureScene(const cv::Mat& filledDepth, const cv::Mat& color, const CocCoefficients& k);
 
 /// The analysis from a measurement: tile CoC ranges (CoC is monotonic in depth, so a tile's

@@ -34,6 +34,21 @@ Texture::Texture(GLenum internalFormat, int width, int height, std::string_view 
     label(GL_TEXTURE, id, name);
 }
 
+Texture Texture::view(const Texture& of, GLenum internalFormat, std::string_view name)
+{
+    assert(of);
+    Texture texture;
+    GLuint id = 0;
+    glGenTextures(1, &id); // a view's name must not have been bound yet
+    texture.handle_ = Handle<deleteTexture>(id);
+    glTextureView(id, GL_TEXTURE_2D, of.id(), internalFormat, 0, 1, 0, 1);
+    label(GL_TEXTURE, id, name);
+    texture.format_ = internalFormat;
+    texture.width_ = of.width_;
+    texture.height_ = of.height_;
+    return texture;
+}
+
 void Texture::upload(GLenum format, GLenum type, const void* data)
 {
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);

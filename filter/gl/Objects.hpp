@@ -68,6 +68,9 @@ class Texture {
 public:
     Texture() = default;
     Texture(GLenum internalFormat, int width, int height, std::string_view name);
+    /// A view of `of`'s image as `internalFormat`, of the same size and view class (GL_RGB8 of
+    /// GL_SRGB8: the bytes without the sRGB decode). It holds the image; `of` may go first.
+    static Texture view(const Texture& of, GLenum internalFormat, std::string_view name);
 
     GLuint id() const { return handle_.id(); }
     explicit operator bool() const { return bool(handle_); }

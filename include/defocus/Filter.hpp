@@ -57,8 +57,10 @@ public:
 /// Where the time of one frame went, milliseconds.
 struct Timings {
     double totalMs = 0.0;     ///< process(), wall clock
-    double depthPrepMs = 0.0; ///< depth resized to the colour and its holes filled (CPU)
-    double analysisMs = 0.0;  ///< scene analysis and the plan (CPU)
+    /// Depth resized to the colour, its holes filled and the scene measured: submitting the
+    /// GPU's passes, or the CPU's work on a software renderer (llvmpipe), where that is faster.
+    double depthPrepMs = 0.0;
+    double analysisMs = 0.0;  ///< waiting for the measurement, the scene analysis and the plan
     double uploadMs = 0.0;    ///< colour and depth to the GPU
     double renderMs = 0.0;    ///< submitting the passes
     double readbackMs = 0.0;  ///< the output pass and reading the result back
@@ -195,8 +197,8 @@ public:
     /// process() for a frame in textures of the caller's context (ContextOptions::callerContext;
     /// otherwise it throws InputError): the same result as process() of the same images, byte for
     /// byte, into `frame.output` (Settings::output is taken as Srgb8). Call it on the thread where
-    /// that context is current. The CPU's depth preparation and scene analysis read the colour and
-    /// depth back (glGetTextureImage); the output is rendered on the GPU, except frames all in
+    /// that context is current. The colour and depth are read back (glGetTextureImage) and go
+    /// through depth preparation and the scene measurement as process()'s do; the output is rendered on the GPU, except frames all in
     /// focus and the depth and coc views, which are uploaded. The call waits for no fence: the
     /// caller orders its own work around it (GStreamer: GstGLSyncMeta). GL state: it puts back the
     /// framebuffer bindings, viewport, program, vertex array, active texture, the 2D texture and

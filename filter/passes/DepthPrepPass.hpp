@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Depth prep on the GPU: the depth as it came (R32F metres, any size of the frame's aspect) made
+// the frame's size by nearest neighbour and its holes filled by push-pull, and for float frames
+// with bokeh sprites a light's edge put at the light's depth. The same result as prepareDepth()
+// and putLightEdgesAtTheirLightsDepth() on the CPU (filter/DepthPrep.hpp), without the frame's
+// depth touching the CPU. Shader: depth_prep.frag, one full-screen triangle per step and level.
+#pragma once
+
+#include <vector>
+
+#include "filter/gl/Objects.hpp"
+#include "filter/gl/Program.hpp"
+
+namespace defocus {
+
+class DepthPrepPass {
+public:
+    static constexpr const char* kName = "depth-prep";
+    DepthPrepPass();
+
+    /// Fills `filled` (R32F, the frame's size) from `depth` (R32F metres; nullptr: the frame has
+    /// no depth, and all of it sits at `fallbackM`, as when no pixel of `depth` is a
+    /// measurement). `lightColor`: a float frame's linear colour, whose pixels above white take
+    /// the depth of the brightest nearer pixel round them; nullptr: no such step. Needs a
+    /// vertex array bound (the full-screen triangle).
+    void run(const gl::Texture* depth, float fallbackM, const gl::Texture* lightColor, const gl::Texture& filled);
+    /// The frame's size, RG32F: g is 1 where the last run's depth had a measurement, 0 at its
+    /// holes (SceneMeasurePass counts them). Empty until a run with depth.
+    const gl::Texture& measured() const { return levels_.empty() ? none_ : levels_.front().pyramid; }
+
+private:
+    struct Level {
+        gl::Texture pyramid;    ///< RG32F: depth, weight
+        gl::Framebuffer pyramidTarget;
+        gl::Texture filled;     ///< R32F: its holes filled (PULL); unused at level 0 and the coarsest
+        gl::Framebuffer filledTarget;
+    };
+    /// Draws `program` into `target` of `width` x `height` pixels.
+    void draw(const gl::Program& program, const gl::Framebuffer& target, int width, int height);
+
+    gl::Program split_, push_, pull_, fill_, lightEdges_;
+    GLint fallbackLocation_ = -1;
+    gl::Sampler nearest_;
+    /// Level 0 has the frame's size, each next one half the last (rounded up), down to 1x1.
+    std::vector<Level> levels_;
+    gl::Texture unlit_; ///< the filled depth before the light edges
+    gl::Texture none_;
+};
+
+} // namespace defocus

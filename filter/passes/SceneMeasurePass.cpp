@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// The scene measurement on the GPU, one work group per tile, read back for the plan.
+#include "filter/passes/SceneMeasurePass.hpp"
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "filter/ColorSpace.hpp"
+#include "filter/passes/CocPass.hpp"
+#include "filter/passes/Pass.hpp"
+
+namespace defocus {
+
+namespace {
+
+/// scene_measure.comp's buffer: a header of counts, then a Tile per tile.
+struct Header {
+    std::uint32_t invalidPixels;
+    std::uint32_t bins[SceneAnalysis::kHistogramEdges.size() + 1];
+    std::uint32_t unused[2];
+};
+struct Tile {
+    float minDepth, maxDepth;
+    std::uint32_t highlights;
+    float luminance;
+};
+static_assert(sizeof(Header) == 48 && sizeof(Tile) == 16);
+
+} // namespace
+
+SceneMeasurePass::SceneMeasurePass()
+    : program_(gl::Program::compute("scene_measure.comp", "scene measure")),
+      eightBitLocation_(program_.uniform("uEightBit")), countHolesLocation_(program_.uniform("uCountHoles")),
+      cocParams_(sizeof(CocPass::Uniforms), "scene measure coc params"),
+      nearest_(GL_NEAREST, "scene measure nearest")
+{
+    // measureScene()'s decode: the same table, so that the same bytes give the same luminance
+    // (a driver's sRGB decode may approximate: llvmpipe's moved tile sums by 1e-3).
+    std::array<float, 256> decode{};
+    for (std::size_t i = 0; i < decode.size(); ++i)
+        decode[i] = srgbToLinear(static_cast<float>(i) / 255.0f);
+    glProgramUniform1fv(program_.id(), program_.uniform("uDecode"), static_cast<GLsizei>(decode.size()), decode.data());
+}
+
+void SceneMeasurePass::run(const gl::Texture& depth, const gl::Texture& color, bool eightBit,
+                           const CocCoefficients& k, const gl::Texture* measured)
+{
+    constexpr int T = SceneAnalysis::kTileSize;
+    frame_ = {depth.width(), depth.height()};
+    tiles_ = {(frame_.width + T - 1) / T, (frame_.height + T - 1) / T};
+    const auto bytes = static_cast<GLsizeiptr>(sizeof(Header) + tiles_.area() * sizeof(Tile));
+    if (buffer_.size() < bytes)
+        buffer_ = gl::StorageBuffer(bytes, "scene measurement");
+    const Header zero{};
+    buffer_.update(&zero, sizeof zero);
+    everyPixelInvalid_ = measured == nullptr;
+
+    const CocPass::Uniforms u = CocPass::uniforms(k, false, 1.0f);
+    cocParams_.update(&u, sizeof u);
+    cocParams_.bind(0);
+    program_.use();
+    glUniform1i(eightBitLocation_, eightBit ? 1 : 0);
+    glUniform1i(countHolesLocation_, measured ? 1 : 0);
+    bindTexture(0, depth.id(), nearest_.id());
+    bindTexture(1, color.id(), nearest_.id());
+    bindTexture(2, (measured ? *measured : depth).id(), nearest_.id());
+    buffer_.bind(0);
+    glDispatchCompute(static_cast<GLuint>(tiles_.width), static_cast<GLuint>(tiles_.height), 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+SceneMeasurement SceneMeasurePass::read(std::size_t& invalidPixels) const
+{
+    Header header{};
+    std::vector<Tile> tiles(static_cast<std::size_t>(tiles_.area()));
+    buffer_.read(&header, sizeof header);
+    glGetNamedBufferSubData(buffer_.id(), sizeof header, static_cast<GLsizeiptr>(tiles.size() * sizeof(Tile)),
+                            tiles.data());
+    invalidPixels = everyPixelInvalid_ ? static_cast<std::size_t>(frame_.area()) : header.invalidPixels;
+
+    SceneMeasurement m;
+    m.frame = frame_;
+    m.tiles = tiles_;
+    m.pixels = static_cast<std::size_t>(frame_.area());
+    for (std::size_t i = 0; i < m.histogram.size(); ++i)
+        m.histogram[i] = static_cast<int>(header.bins[i]);
+    m.tileMinDepth.create(tiles_, CV_32F);
+    m.tileMaxDepth.create(tiles_, CV_32F);
+    m.tileHighlights.create(tiles_, CV_32S);
+    m.tileLuminance.create(tiles_, CV_32F);
+    for (int ty = 0, i = 0; ty < tiles_.height; ++ty)
+        for (int tx = 0; tx < tiles_.width; ++tx, ++i) {
+            const Tile& t = tiles[static_cast<std::size_t>(i)];
+            m.tileMinDepth.at<float>(ty, tx) = t.minDepth;
+            m.tileMaxDepth.at<float>(ty, tx) = t.maxDepth;
+            m.tileHighlights.at<int>(ty, tx) = static_cast<int>(t.highlights);
+            m.tileLuminance.at<float>(ty, tx) = t.luminance;
+            m.highlightPixels += t.highlights;
+        }
+    return m;
+}
+
+} // namespace defocus

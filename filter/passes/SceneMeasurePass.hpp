@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// The scene measurement on the GPU: per 16x16 tile the depth range, the highlight pixels and the
+// summed luminance, and the frame's |CoC| histogram, from the filled depth and the colour as the
+// CoC pass samples them; what measureScene() measures on the CPU (filter/SceneAnalysis.hpp).
+// Only the measurement comes back (16 bytes a tile), for the plan. Shader: scene_measure.comp.
+#pragma once
+
+#include <cstddef>
+
+#include <opencv2/core.hpp>
+
+#include "filter/Lens.hpp"
+#include "filter/SceneAnalysis.hpp"
+#include "filter/gl/Objects.hpp"
+#include "filter/gl/Program.hpp"
+
+namespace defocus {
+
+class SceneMeasurePass {
+public:
+    static constexpr const char* kName = "scene-measure";
+    SceneMeasurePass();
+
+    /// Measures `depth` (R32F metres, filled) and `color`, both of the frame's size, with the
+    /// CoC of `k`: `color` is float linear, or with `eightBit` the frame's sRGB bytes undecoded
+    /// (GL_RGB8, a view of the CoC pass's sRGB8 texture: Texture::view()). `measured`:
+    /// DepthPrepPass::measured(), whose holes are counted; nullptr for a frame without depth.
+    void run(const gl::Texture& depth, const gl::Texture& color, bool eightBit, const CocCoefficients& k,
+             const gl::Texture* measured);
+    /// Waits for the measurement and returns it, with the pixels of the depth that had no
+    /// measurement in `invalidPixels` (all of them for a frame without depth).
+    SceneMeasurement read(std::size_t& invalidPixels) const;
+
+private:
+    gl::Program program_;
+    GLint eightBitLocation_ = -1, countHolesLocation_ = -1;
+    gl::UniformBuffer cocParams_;
+    gl::Sampler nearest_;
+    gl::StorageBuffer buffer_;
+    cv::Size frame_, tiles_;
+    bool everyPixelInvalid_ = false; ///< the last frame had no depth
+};
+
+} // namespace defocus
