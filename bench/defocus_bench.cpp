@@ -70,8 +70,9 @@ struct Options : cli::QualityNames {
     /// off: the path before quarter size), in a second pipeline, frame by frame alternating with
     /// the first: before and after as a ratio within one run.
     bool versusHalfOnly = false;
-    /// Also time the defocused scene with depth prep and the scene measurement on the CPU
-    /// (Pipeline::prepareOnGpu off), in a second pipeline, frames alternating as above.
+    /// Depth prep and the scene measurement on the GPU in the main pipeline, and also the
+    /// defocused scene with them on the CPU (Pipeline::prepareOnGpu off), in a second pipeline,
+    /// frames alternating as above.
     bool versusCpuPrep = false;
     std::string json;
 };
@@ -444,6 +445,7 @@ int run(const Options& options, const std::string& commandLine)
         versusPipeline->finishEachPass(options.finishEachPass);
         versusScene = "half only";
     } else if (options.versusCpuPrep) {
+        pipeline.prepareOnGpu(true); // whatever the renderer's default
         versusPipeline.emplace(!options.noTimers);
         versusPipeline->finishEachPass(options.finishEachPass);
         versusPipeline->prepareOnGpu(false);
@@ -715,8 +717,9 @@ int main(int argc, char** argv)
                  "Also time the defocused scene always at half size (quarter size on large blur off: the path "
                  "before it), frames alternating with the main settings', and print the ratio of frame times");
     app.add_flag("--versus-cpu-prep", o.versusCpuPrep,
-                 "Also time the defocused scene with depth prep and the scene measurement on the CPU (the "
-                 "filled depth uploaded), frames alternating with the GPU's, and print the ratio of frame times")
+                 "Depth prep and the scene measurement on the GPU (the default but on software renderers), and "
+                 "also the defocused scene with them on the CPU (the filled depth uploaded), frames alternating "
+                 "with the GPU's, and print the ratio of frame times")
         ->excludes(halfOnly);
     app.add_flag("--finish-each-pass", o.finishEachPass,
                  "Profiling: glFinish before and after each pass, and wall ms per pass instead of timer queries "
