@@ -58,12 +58,15 @@ case ${1:-} in
     step info "$unpacked/bin/defocus" --info
     step throughput "$unpacked/bin/defocus-bench" throughput --sizes "$sizes" --frames "$frames" --passes 3
     step passes "$unpacked/bin/defocus-bench" --sizes "$sizes" --runs "$frames" --warmup 5 --json "$out/bench.json"
+    # Depth prep and the scene measurement on the GPU against the CPU's, frames alternating.
+    step prep "$unpacked/bin/defocus-bench" --sizes "$sizes" --runs "$frames" --warmup 5 --versus-cpu-prep \
+      --json "$out/bench-prep.json"
     # The apertures beside the hexagon (needs python3-opencv there to make the frames).
     for size in 1920x1080 3840x2160; do
       step "apertures-$size" scripts/aperture-cost.sh "$unpacked/bin" data/corpus/spheres-far-focus "$size" 20 3 ||
         echo "gpu-figures: apertures at $size not measured (see $out/apertures-$size.txt)"
     done
-    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, apertures-*.txt"
+    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, prep.txt, bench-prep.json, apertures-*.txt"
     ;;
   *)
     echo "usage: scripts/gpu-figures.sh pack [BUILD_DIR] | run [OUT_DIR]" >&2
