@@ -6,7 +6,9 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <mutex>
+#include <utility>
 #include <string_view>
 
 #include <epoxy/gl.h>
@@ -136,6 +138,51 @@ bool softwareRenderer()
 
 } // namespace
 
+/// One frame from begin() until the one after it is begun: its images and settings, what they
+/// derive, what the GPU holds of it (its own textures and measurement, so that the next frame
+/// can go up and be measured before this one's passes run) and what the CPU found.
+struct FrameContext {
+    /// The frame's images, kept until its passes have run (they are skipped when all is in
+    /// focus and the composite is all that is read).
+    cv::Mat color, depthInput;
+    cv::Size size;
+    QualitySettings quality;
+    /// The gather's CoC: the lens', scaled so that the rhombi's hexagon covers the aperture's
+    /// area (gatherScale(); 1 for the hexagon). The sprites draw the aperture itself.
+    CocCoefficients coefficients;
+    float maxCocPx = 0.0f;
+    ApertureShape aperture;
+    float bladeRotationDeg = 0.0f; ///< the gather's hexagon's
+    float gatherScale = 1.0f;      ///< gatherScale(aperture): the gather's CoC over the lens'
+    RhombusBlurPass::Directions directions{}; ///< the rhombi's: rotated and squeezed as the aperture is
+    float fallbackDepth = 1.0f;
+    std::size_t frameIndex = 0;
+    FrameTimings timings;
+    Clock::time_point frameStart;
+
+    gl::Texture colorTexture;
+    gl::Texture colorBytes;   ///< 8-bit frames: colorTexture's bytes, undecoded (SceneMeasurePass)
+    gl::Texture depthAsGiven; ///< the frame's depth as it came (prepareOnGpu)
+    gl::Texture depth;        ///< filled, the frame's size
+    gl::StorageBuffer measurementBuffer; ///< SceneMeasurePass's, until read
+    bool measuring = false;   ///< the GPU's measurement is submitted and not yet read
+    bool hasDepth = false;    ///< the frame came with depth (the GPU's measurement counts its holes)
+    SceneMeasurement measurement;
+
+    /// The all-in-focus exit: decided from the valid depths' range before anything else, with
+    /// the CoC of its two ends; depth prep then waits until a view needs it.
+    bool inFocusExit = false;
+    float exitMinCoc = 0.0f, exitMaxCoc = 0.0f;
+    bool depthPrepared = false; ///< depth prep has run (or been submitted)
+    /// The filled depth on the CPU: prepareDepth()'s, or read back from the GPU when asked for.
+    PreparedDepth prepared;
+    bool preparedOnCpu = false; ///< `prepared` holds this frame's filled depth
+    /// The frame's share of depth without a measurement, from hole filling or, on the
+    /// all-in-focus exit, from the look at the depth range that decided it.
+    double invalidFraction = 0.0;
+    float nearestDepth = 0.0f, farthestDepth = 0.0f; ///< the filled depth's range (the depth view)
+};
+
 struct Pipeline::Impl {
     gl::VertexArray vao = gl::VertexArray::create();
     DepthPrepPass depthPrepPass;
@@ -159,10 +206,6 @@ struct Pipeline::Impl {
     bool upscaleUsesTiles = false;
     gl::GpuTimer timer;
 
-    gl::Texture colorTexture;
-    gl::Texture colorBytes;   ///< 8-bit frames: colorTexture's bytes, undecoded (SceneMeasurePass)
-    gl::Texture depthAsGiven; ///< the frame's depth as it came (prepareOnGpu)
-    gl::Texture depth;        ///< filled, the frame's size
     Target coc, horizontal, diagonalA, diagonalB, outSrgb, outLinear;
     // Rhombi: pass 1 writes X (horizontal) and Z (horizontalMean), pass 2 A and B (diagonalA/B).
     Target horizontalMean;
@@ -173,21 +216,20 @@ struct Pipeline::Impl {
     TargetPair prefiltered;
     gl::Texture nearDiameter;            ///< per tile, R32F
 
-    cv::Size size;     ///< the frame's
+    /// The frame the passes, the reads and the accessors are of: the one finish() took last.
+    FrameContext current;
+    /// Frames begin() took that finish() has not, oldest first.
+    std::deque<FrameContext> staged;
+    /// Contexts of frames done with, for the next begin() to reuse their textures and buffers.
+    std::vector<FrameContext> spare;
+    cv::Size size;     ///< current's
     cv::Size blurSize; ///< the blur passes': the frame's, or half or a quarter of it (Resolution::Half)
     int blurShift = 0; ///< log2 of size / blurSize (the plan's FramePlan::blurShift)
     /// Depth prep and the scene measurement on the GPU (DepthPrepPass, SceneMeasurePass), or
     /// on the CPU (prepareDepth(), measureScene()) with the filled depth uploaded: the CPU on a
     /// software renderer (softwareRenderer()), the GPU on any other.
     bool prepareOnGpu = !softwareRenderer();
-    /// The filled depth on the CPU: prepareDepth()'s, or read back from the GPU when asked for.
-    PreparedDepth prepared;
-    bool preparedOnCpu = false; ///< `prepared` holds this frame's filled depth
     DepthPrepWorkspace depthWorkspace; // prepareDepth()'s buffers, kept from frame to frame
-    float nearestDepth = 0.0f, farthestDepth = 0.0f; ///< the filled depth's range (the depth view)
-    float maxCocPx = 0.0f;
-    FrameTimings timings;
-    Clock::time_point frameStart;
     /// Readback buffers collected and free again, for the next reads of their size.
     std::vector<gl::ReadbackBuffer> spareReadbacks;
     /// A spare readback buffer of at least `bytes` (those too small are dropped), or a new one.
@@ -202,29 +244,11 @@ struct Pipeline::Impl {
         return gl::ReadbackBuffer(bytes, "readback");
     }
 
-    // The last frame, kept until its passes have run (they are skipped when all is in focus
-    // and the composite is all that is read).
-    cv::Mat color;
-    /// The gather's CoC: the lens', scaled so that the rhombi's hexagon covers the aperture's
-    /// area (gatherScale(); 1 for the hexagon). The sprites draw the aperture itself.
-    CocCoefficients coefficients;
-    QualitySettings quality;
-    float bladeRotationDeg = 0.0f; ///< the gather's hexagon's
-    ApertureShape aperture;
-    float gatherScale = 1.0f; ///< gatherScale(aperture): the gather's CoC over the lens'
-    RhombusBlurPass::Directions directions{}; ///< the rhombi's: rotated and squeezed as the aperture is
     SceneAnalysis analysis;
     FramePlan plan;
     bool rendered = false;
     bool rhombiSecondPending = false; ///< rhombi: pass 2 of this frame has not written A and B
     bool rhombiUsesTiles = false;
-    bool depthPrepared = false; ///< the all-in-focus exit skips hole filling until a view needs it
-    /// The frame's share of depth without a measurement, from hole filling or, on the
-    /// all-in-focus exit, from the look at the depth range that decided it.
-    double invalidFraction = 0.0;
-    cv::Mat depthInput;
-    float fallbackDepth = 1.0f;
-    std::size_t frameIndex = 0;
     std::size_t gpuFrameIndex = 0; ///< frame whose GPU scopes are pending in the timer
 
     void render();
@@ -246,17 +270,23 @@ struct Pipeline::Impl {
             rhombiSecondPass(nullptr);
     }
     void uploadNearDiameter();
-    /// The frame's colour into colorTexture (and its bytes' view).
-    void uploadColor()
+    /// `f`'s colour into its colorTexture (and its bytes' view).
+    static void uploadColor(FrameContext& f)
     {
-        const bool srgbInput = color.depth() == CV_8U;
-        if (ensureTexture(colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, size, "input colour"))
-            colorBytes = srgbInput ? gl::Texture::view(colorTexture, GL_RGB8, "input colour, bytes") : gl::Texture();
+        const bool srgbInput = f.color.depth() == CV_8U;
+        if (ensureTexture(f.colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, f.size, "input colour"))
+            f.colorBytes = srgbInput ? gl::Texture::view(f.colorTexture, GL_RGB8, "input colour, bytes") : gl::Texture();
         // BGRx goes up as it is: the texture has no alpha, so the fourth byte is dropped on the way.
-        colorTexture.upload(color.channels() == 4 ? GL_BGRA : GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT,
-                            color.data);
+        f.colorTexture.upload(f.color.channels() == 4 ? GL_BGRA : GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT,
+                              f.color.data);
     }
-    void prepareDepthAndPlan();
+    /// begin()'s work on `f`: the frame, its settings, the all-in-focus exit or depth prep.
+    void begin(FrameContext& f, const Frame& frame, const LensSettings& lens, const QualitySettings& quality);
+    /// Depth prep and the scene measurement of `f`: on the GPU, the frame's images uploaded and
+    /// the measurement submitted (read by plan()); on the CPU, both done and the filled depth uploaded.
+    void prepare(FrameContext& f);
+    /// The current frame's measurement (waiting for the GPU's), analysis and plan.
+    void planFrame();
     void setBlurShift(int shift)
     {
         blurShift = shift;
@@ -271,7 +301,7 @@ struct Pipeline::Impl {
     void composite(const gl::Framebuffer& target)
     {
         const bool near = plan.nearField;
-        if (quality.kernel == HexagonKernel::RhombiSum)
+        if (current.quality.kernel == HexagonKernel::RhombiSum)
             compositePass.runSum(diagonalA.texture, diagonalB.texture, target);
         else
             compositePass.run(diagonalA.texture, diagonalB.texture, target, near ? &nearA.texture : nullptr,
@@ -316,146 +346,211 @@ Pipeline::Pipeline(bool timers)
     quality.resolution = Resolution::Half;
     run({color, depth, 0.0, 0, "warm-up"}, lens, quality, View::Composite, Encoding::Srgb8);
     drainGpuTimes();
-    impl_->timings = {};
+    impl_->current.timings = {};
 }
 
 Pipeline::~Pipeline() = default;
 
 void Pipeline::process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality)
 {
+    CV_Assert(impl_->staged.empty());
+    begin(frame, lens, quality);
+    finish();
+}
+
+void Pipeline::begin(const Frame& frame, const LensSettings& lens, const QualitySettings& quality)
+{
     Impl& p = *impl_;
     CV_Assert(!frame.color.empty() &&
               (frame.color.type() == CV_8UC3 || frame.color.type() == CV_8UC4 || frame.color.type() == CV_32FC3));
-    p.timings = {};
-    p.frameStart = Clock::now();
-    p.size = frame.color.size();
-    p.setBlurShift(quality.resolution == Resolution::Half ? 1 : 0);
+    FrameContext f;
+    if (!p.spare.empty()) {
+        f = std::move(p.spare.back());
+        p.spare.pop_back();
+    }
+    p.begin(f, frame, lens, quality);
+    p.staged.push_back(std::move(f));
+}
 
-    auto start = Clock::now();
-    p.color = frame.color;
-    p.depthInput = frame.depth;
-    p.quality = quality;
-    p.aperture = ApertureShape::of(lens);
+std::size_t Pipeline::begun() const
+{
+    return impl_->staged.size();
+}
+
+void Pipeline::dropBegun()
+{
+    Impl& p = *impl_;
+    for (FrameContext& f : p.staged)
+        p.spare.push_back(std::move(f));
+    p.staged.clear();
+}
+
+void Pipeline::Impl::begin(FrameContext& f, const Frame& frame, const LensSettings& lens,
+                           const QualitySettings& quality)
+{
+    f.timings = {};
+    f.frameStart = Clock::now();
+    f.size = frame.color.size();
+    f.color = frame.color;
+    f.depthInput = frame.depth;
+    f.quality = quality;
+    f.aperture = ApertureShape::of(lens);
     // The gather's hexagon: the lens' for a hexagonal aperture; for other shapes a corner on top,
     // whose lines lie on the axes (a rotated hexagon's off-axis lines cost llvmpipe 8x as much).
-    p.bladeRotationDeg = p.aperture.isHexagon() ? static_cast<float>(lens.bladeRotationDeg) : 0.0f;
-    const GatherSqueeze squeeze = gatherSqueeze(p.aperture);
-    p.directions = RhombusBlurPass::directions(p.bladeRotationDeg, squeeze.x, squeeze.y);
-    const CocCoefficients lensCoc = cocCoefficients(lens, p.size.width);
-    p.gatherScale = gatherScale(p.aperture);
-    p.coefficients = scaled(lensCoc, p.gatherScale);
-    p.maxCocPx = lensCoc.maxCocPx;
-    p.frameIndex = frame.index;
-    p.fallbackDepth = std::isinf(lens.focusM) ? 1e6f : static_cast<float>(lens.focusM);
-    p.rendered = false;
-    p.depthPrepared = false;
-    p.plan = {};
+    f.bladeRotationDeg = f.aperture.isHexagon() ? static_cast<float>(lens.bladeRotationDeg) : 0.0f;
+    const GatherSqueeze squeeze = gatherSqueeze(f.aperture);
+    f.directions = RhombusBlurPass::directions(f.bladeRotationDeg, squeeze.x, squeeze.y);
+    const CocCoefficients lensCoc = cocCoefficients(lens, f.size.width);
+    f.gatherScale = gatherScale(f.aperture);
+    f.coefficients = scaled(lensCoc, f.gatherScale);
+    f.maxCocPx = lensCoc.maxCocPx;
+    f.frameIndex = frame.index;
+    f.fallbackDepth = std::isinf(lens.focusM) ? 1e6f : static_cast<float>(lens.focusM);
+    f.depthPrepared = false;
+    f.preparedOnCpu = false;
+    f.measuring = false;
+    f.inFocusExit = false;
 
     // All in focus? Hole filling only averages valid depths, so the valid range bounds the
     // filled map, and CoC is monotonic in depth: the CoC of the two ends decides, before any
     // hole filling, analysis or upload. The lens' CoC: a lens that blurs nothing by half a pixel
     // passes the frame through whatever the gather's scale.
     if (quality.adaptive) {
-        float lo = p.fallbackDepth, hi = p.fallbackDepth;
-        p.invalidFraction = validDepthRange(frame.depth, lo, hi);
+        const auto start = Clock::now();
+        float lo = f.fallbackDepth, hi = f.fallbackDepth;
+        f.invalidFraction = validDepthRange(frame.depth, lo, hi);
         const float c0 = cocPixels(lensCoc, lo), c1 = cocPixels(lensCoc, hi);
+        f.timings.analysisMs = msSince(start);
         if (std::max(std::abs(c0), std::abs(c1)) < 0.5f) {
-            p.analysis = {};
-            p.analysis.minCoc = std::min(c0, c1);
-            p.analysis.maxCoc = std::max(c0, c1);
-            p.plan = {};
-            p.plan.allInFocus = true;
-            p.timings.analysisMs = msSince(start);
+            f.inFocusExit = true;
+            f.exitMinCoc = std::min(c0, c1);
+            f.exitMaxCoc = std::max(c0, c1);
             return;
         }
     }
-    p.prepareDepthAndPlan();
-    p.timings.analysisMs = msSince(start) - p.timings.depthPrepMs - p.timings.uploadMs;
-    if (!(quality.adaptive && p.plan.allInFocus))
+    prepare(f);
+}
+
+void Pipeline::finish()
+{
+    Impl& p = *impl_;
+    CV_Assert(!p.staged.empty());
+    p.spare.push_back(std::exchange(p.current, std::move(p.staged.front())));
+    p.staged.pop_front();
+    FrameContext& f = p.current;
+    p.size = f.size;
+    p.setBlurShift(f.quality.resolution == Resolution::Half ? 1 : 0);
+    p.rendered = false;
+    p.plan = {};
+    p.analysis = {};
+    if (f.inFocusExit) {
+        p.analysis.minCoc = f.exitMinCoc;
+        p.analysis.maxCoc = f.exitMaxCoc;
+        p.plan.allInFocus = true;
+        return;
+    }
+    const auto start = Clock::now();
+    p.planFrame();
+    f.timings.analysisMs += msSince(start);
+    if (!(f.quality.adaptive && p.plan.allInFocus))
         p.render();
 }
 
-void Pipeline::Impl::prepareDepthAndPlan()
+void Pipeline::Impl::prepare(FrameContext& f)
 {
     // Depth: colour-sized, holes filled. With no depth at all, everything sits on the focus plane.
     // The rhombi's bokeh sprites take the light above white out of the gather; its edges go with
     // it (float frames only: 8-bit ones have nothing above white).
     const bool lightEdges =
-        color.type() == CV_32FC3 && quality.kernel == HexagonKernel::RhombiSum && quality.highlightSprites;
-    const bool srgbInput = color.depth() == CV_8U;
-    CV_Assert(color.isContinuous() && (depthInput.empty() || depthInput.type() == CV_32FC1));
-    SceneMeasurement measurement;
+        f.color.type() == CV_32FC3 && f.quality.kernel == HexagonKernel::RhombiSum && f.quality.highlightSprites;
+    const bool srgbInput = f.color.depth() == CV_8U;
+    CV_Assert(f.color.isContinuous() && (f.depthInput.empty() || f.depthInput.type() == CV_32FC1));
     auto start = Clock::now();
     if (prepareOnGpu) {
-        // The frame's pixels go up as they came; only the measurement comes back.
-        uploadColor();
-        ensureTexture(depth, GL_R32F, size, "filled depth");
-        const cv::Mat given = depthInput.isContinuous() ? depthInput : depthInput.clone();
-        if (!given.empty()) {
-            ensureTexture(depthAsGiven, GL_R32F, given.size(), "depth as given");
-            depthAsGiven.upload(GL_RED, GL_FLOAT, given.data);
+        // The frame's pixels go up as they came; only the measurement comes back, read when the
+        // frame is planned (planFrame()), by when the GPU has long made it when a frame is in
+        // flight before it.
+        uploadColor(f);
+        ensureTexture(f.depth, GL_R32F, f.size, "filled depth");
+        f.hasDepth = !f.depthInput.empty();
+        const cv::Mat given = f.depthInput.isContinuous() ? f.depthInput : f.depthInput.clone();
+        if (f.hasDepth) {
+            ensureTexture(f.depthAsGiven, GL_R32F, given.size(), "depth as given");
+            f.depthAsGiven.upload(GL_RED, GL_FLOAT, given.data);
         }
-        timings.uploadMs = msSince(start);
+        f.timings.uploadMs = msSince(start);
         start = Clock::now();
         glBindVertexArray(vao.id());
         timer.begin(DepthPrepPass::kName);
-        depthPrepPass.run(given.empty() ? nullptr : &depthAsGiven, fallbackDepth, lightEdges ? &colorTexture : nullptr,
-                          depth);
+        depthPrepPass.run(f.hasDepth ? &f.depthAsGiven : nullptr, f.fallbackDepth,
+                          lightEdges ? &f.colorTexture : nullptr, f.depth);
         timer.end();
         timer.begin(SceneMeasurePass::kName);
-        sceneMeasurePass.run(depth, srgbInput ? colorBytes : colorTexture, srgbInput, coefficients,
-                             given.empty() ? nullptr : &depthPrepPass.measured());
+        sceneMeasurePass.run(f.depth, srgbInput ? f.colorBytes : f.colorTexture, srgbInput, f.coefficients,
+                             f.hasDepth ? &depthPrepPass.measured() : nullptr, f.measurementBuffer);
         timer.end();
-        timings.depthPrepMs = msSince(start);
-        std::size_t invalidPixels = 0;
-        measurement = sceneMeasurePass.read(invalidPixels);
-        invalidFraction = static_cast<double>(invalidPixels) / static_cast<double>(size.area());
-        preparedOnCpu = false;
+        f.timings.depthPrepMs = msSince(start);
+        f.measuring = true;
     } else {
-        prepareDepth(depthInput, size, fallbackDepth, depthWorkspace, prepared);
+        prepareDepth(f.depthInput, f.size, f.fallbackDepth, depthWorkspace, f.prepared);
         if (lightEdges)
-            putLightEdgesAtTheirLightsDepth(color, prepared.metres);
-        timings.depthPrepMs = msSince(start);
-        invalidFraction = prepared.invalidFraction;
-        preparedOnCpu = true;
+            putLightEdgesAtTheirLightsDepth(f.color, f.prepared.metres);
+        f.timings.depthPrepMs = msSince(start);
+        f.invalidFraction = f.prepared.invalidFraction;
+        f.preparedOnCpu = true;
 
         start = Clock::now();
-        ensureTexture(depth, GL_R32F, size, "filled depth");
-        uploadColor();
-        CV_Assert(prepared.metres.isContinuous());
-        depth.upload(GL_RED, GL_FLOAT, prepared.metres.data);
-        timings.uploadMs = msSince(start);
-        measurement = measureScene(prepared.metres, color, coefficients);
+        ensureTexture(f.depth, GL_R32F, f.size, "filled depth");
+        uploadColor(f);
+        CV_Assert(f.prepared.metres.isContinuous());
+        f.depth.upload(GL_RED, GL_FLOAT, f.prepared.metres.data);
+        f.timings.uploadMs = msSince(start);
+        start = Clock::now();
+        f.measurement = measureScene(f.prepared.metres, f.color, f.coefficients);
+        f.timings.analysisMs += msSince(start);
     }
-    depthPrepared = true;
+    f.depthPrepared = true;
+}
+
+void Pipeline::Impl::planFrame()
+{
+    FrameContext& f = current;
+    if (!f.depthPrepared)
+        prepare(f);
+    if (f.measuring) {
+        std::size_t invalidPixels = 0;
+        f.measurement = SceneMeasurePass::read(f.measurementBuffer, f.size, f.hasDepth, invalidPixels);
+        f.invalidFraction = static_cast<double>(invalidPixels) / static_cast<double>(f.size.area());
+        f.measuring = false;
+    }
     double lo = 0.0, hi = 0.0;
-    cv::minMaxLoc(measurement.tileMinDepth, &lo);
-    cv::minMaxLoc(measurement.tileMaxDepth, nullptr, &hi);
-    nearestDepth = static_cast<float>(lo);
-    farthestDepth = static_cast<float>(hi);
-    analysis = finishAnalysis(measurement, coefficients, invalidFraction);
-    const bool allInFocus = plan.allInFocus && quality.adaptive;
+    cv::minMaxLoc(f.measurement.tileMinDepth, &lo);
+    cv::minMaxLoc(f.measurement.tileMaxDepth, nullptr, &hi);
+    f.nearestDepth = static_cast<float>(lo);
+    f.farthestDepth = static_cast<float>(hi);
+    analysis = finishAnalysis(f.measurement, f.coefficients, f.invalidFraction);
+    const bool allInFocus = plan.allInFocus && current.quality.adaptive;
     // Highlights to treat: the plan's (FramePlan::highlights) on a frame not all in focus, which
     // makePlan() derives from the analysis alone, whatever size it picks.
     const bool lights = analysis.hasHighlights() && !analysis.allInFocus();
-    const bool eightBit = color.depth() == CV_8U;
-    const double highlightGain = eightBit && lights ? quality.highlightGain : 1.0;
+    const bool eightBit = current.color.depth() == CV_8U;
+    const double highlightGain = eightBit && lights ? current.quality.highlightGain : 1.0;
     // Sprites where a blurred pixel can be brighter than white: float input's highlights, or
     // 8-bit ones scaled up by the gain; and only where such pixels are few, lights rather than
     // bright surfaces (HighlightSpritePass::kMostHighlightPixels).
-    const bool sprites = quality.highlightSprites && quality.kernel == HexagonKernel::RhombiSum && lights &&
+    const bool sprites = current.quality.highlightSprites && current.quality.kernel == HexagonKernel::RhombiSum && lights &&
                          (!eightBit || highlightGain > 1.0) &&
                          analysis.highlightFraction <= HighlightSpritePass::kMostHighlightPixels;
     // Quarter size only on frames without bokeh sprites: the rims of the lights' hexagons, which
     // the gather draws up to white, came out 4 px soft at quarter size (the corpus enlarged 3x,
     // `defocus-bench accuracy --scale 3`: 0.38 dB less in the median, most of it in the lights'
     // zone; docs/benchmarks.md).
-    plan = makePlan(analysis, quality.nearField, quality.kernel, quality.resolution, quality.samples,
-                    quality.quarterOnLargeBlur && !sprites);
+    plan = makePlan(analysis, current.quality.nearField, current.quality.kernel, current.quality.resolution, current.quality.samples,
+                    current.quality.quarterOnLargeBlur && !sprites);
     setBlurShift(plan.blurShift);
     plan.highlightGain = highlightGain;
     plan.highlightSprites = sprites;
-    plan.gatherScale = gatherScale;
+    plan.gatherScale = current.gatherScale;
     plan.allInFocus = plan.allInFocus || allInFocus;
 }
 
@@ -482,10 +577,10 @@ void Pipeline::Impl::renderMcIntosh(bool useTiles)
     // the same ways (mod 60 deg), so the edge nearest an axis is the rhombi's u1: with a corner
     // on top (rotation 0) the edges are vertical and the passes run at 90 and 90 +- 120 deg; with
     // a flat top (30) at 0 and +-120, as published.
-    const float first = RhombusBlurPass::directions(bladeRotationDeg).u1;
+    const float first = RhombusBlurPass::directions(current.bladeRotationDeg).u1;
     const auto blur = [&](const char* name, const gl::Texture& source, float angle, const Target& target) {
         timer.begin(name);
-        hexBlurPass.run(source, depth, angle, quality.samples, target.framebuffer, useTiles ? &blurTiles : nullptr);
+        hexBlurPass.run(source, current.depth, angle, current.quality.samples, target.framebuffer, useTiles ? &blurTiles : nullptr);
         if (useTiles)
             copyPass.run(source, copyTiles, target.framebuffer);
         timer.end();
@@ -501,10 +596,10 @@ void Pipeline::Impl::renderMcIntosh(bool useTiles)
         uploadNearDiameter();
         nearTiles.set(plan.nearTiles, blurSize, tileSize());
         timer.begin("near-field");
-        nearBlurPass.run(coc.texture, nearDiameter, first, quality.samples, true, nearHorizontal.framebuffer, nearTiles);
-        nearBlurPass.run(nearHorizontal.texture, nearDiameter, first + 120.0f, quality.samples, false,
+        nearBlurPass.run(coc.texture, nearDiameter, first, current.quality.samples, true, nearHorizontal.framebuffer, nearTiles);
+        nearBlurPass.run(nearHorizontal.texture, nearDiameter, first + 120.0f, current.quality.samples, false,
                          nearA.framebuffer, nearTiles);
-        nearBlurPass.run(nearHorizontal.texture, nearDiameter, first - 120.0f, quality.samples, false,
+        nearBlurPass.run(nearHorizontal.texture, nearDiameter, first - 120.0f, current.quality.samples, false,
                          nearB.framebuffer, nearTiles);
         timer.end();
     }
@@ -527,7 +622,7 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
     }
     const TileList* tiles = useTiles ? &blurTiles : nullptr;
     timer.begin("rhombi-1");
-    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, directions, quality.samples, tileSize(), tiles,
+    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, current.directions, current.quality.samples, tileSize(), tiles,
                         false, plan.unrolledTaps);
     if (useTiles)
         copyPass.run(coc.texture, copyTiles, first, true);
@@ -545,7 +640,7 @@ void Pipeline::Impl::rhombiSecondPass(const gl::Framebuffer* fusedTarget)
     glBindVertexArray(vao.id());
     timer.begin("rhombi-2");
     rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, target}, false,
-                        directions, quality.samples, tileSize(), tiles,
+                        current.directions, current.quality.samples, tileSize(), tiles,
                         fusedTarget != nullptr, plan.unrolledTaps);
     if (rhombiUsesTiles)
         copyPass.run(horizontal.texture, copyTiles, target, fusedTarget == nullptr);
@@ -568,14 +663,14 @@ void Pipeline::Impl::upscale(const gl::Framebuffer& out)
     }
     sharpened.ensure(coc.texture.format(), blurSize, "half-size result, sharpened");
     added.ensure(coc.texture.format(), blurSize, "half-size result minus input");
-    const UpscalePass::Io io{colorTexture,     depth,         coc.texture,
+    const UpscalePass::Io io{current.colorTexture,     current.depth,         coc.texture,
                              blurred.texture,  sharpened.texture, added.texture,
                              prefiltered.of(sharpened, added, "upscale prefilter"), out};
     timer.begin(UpscalePass::kPrefilterName);
     upscalePass.prefilter(io);
     timer.end();
     timer.begin(UpscalePass::kName);
-    upscalePass.upscale(io, coefficients, quality.targetFormat == TargetFormat::Rgba16F, blurShift,
+    upscalePass.upscale(io, current.coefficients, current.quality.targetFormat == TargetFormat::Rgba16F, blurShift,
                         upscaleUsesTiles ? &detailTiles : nullptr,
                         plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f);
     timer.end();
@@ -583,23 +678,23 @@ void Pipeline::Impl::upscale(const gl::Framebuffer& out)
 
 void Pipeline::Impl::render()
 {
-    if (!depthPrepared)
-        prepareDepthAndPlan();
+    if (!current.depthPrepared)
+        planFrame(); // the all-in-focus exit, rendered for a view or readTarget()
     const auto start = Clock::now();
-    const bool half = quality.targetFormat == TargetFormat::Rgba16F;
+    const bool half = current.quality.targetFormat == TargetFormat::Rgba16F;
     coc.ensure(half ? GL_RGBA16F : GL_RGBA32F, blurSize, "coc");
 
     // Tiles in focus are copied, not blurred, when enough of them are: a thousand small quads
     // cost the rasteriser more than one full-screen triangle (on llvmpipe, drawing 1181 of 1200
     // tiles took 25 % longer than the whole frame), so a few copy tiles are not worth it.
-    const bool useTiles = quality.adaptive && !plan.copyTiles.empty() &&
+    const bool useTiles = current.quality.adaptive && !plan.copyTiles.empty() &&
                           plan.copyTiles.size() * 4 >= plan.copyTiles.size() + plan.blurTiles.size();
     if (useTiles) {
         blurTiles.set(plan.blurTiles, blurSize, tileSize());
         copyTiles.set(plan.copyTiles, blurSize, tileSize());
     }
     // The upscale's detail on tiles by the same rule: when a quarter of them only interpolate.
-    upscaleUsesTiles = quality.adaptive && blurShift != 0 &&
+    upscaleUsesTiles = current.quality.adaptive && blurShift != 0 &&
                        plan.detailTiles.size() * 4 <= static_cast<std::size_t>(analysis.tiles.area()) * 3;
     if (upscaleUsesTiles)
         detailTiles.set(plan.detailTiles, size, SceneAnalysis::kTileSize);
@@ -613,8 +708,8 @@ void Pipeline::Impl::render()
         if (neighbourhoods.size() != bytes)
             neighbourhoods = gl::StorageBuffer(bytes, "tile neighbourhoods");
         neighbourhoods.update(analysis.tileNeighbourhood.data, bytes);
-        highlightSpritePass.find(colorTexture, depth, coefficients, static_cast<float>(plan.highlightGain),
-                                 CocPass::largestColor(half), aperture, plan.nearField,
+        highlightSpritePass.find(current.colorTexture, current.depth, current.coefficients, static_cast<float>(plan.highlightGain),
+                                 CocPass::largestColor(half), current.aperture, plan.nearField,
                                  neighbourhoods, analysis.highlightTiles,
                                  HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
                                                              analysis.highlightPixels));
@@ -624,16 +719,16 @@ void Pipeline::Impl::render()
         highlightTiles.set(analysis.highlightTiles, blurSize, tileSize());
     if (plan.highlightSprites)
         frameHighlightTiles.set(analysis.highlightTiles, size, SceneAnalysis::kTileSize);
-    cocPass.run(colorTexture, depth, coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
+    cocPass.run(current.colorTexture, current.depth, current.coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
                 blurShift, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
                 &neighbourhoods, &highlightSpritePass.sprites(), &highlightTiles);
     timer.end();
     rhombiSecondPending = false;
-    if (quality.kernel == HexagonKernel::RhombiSum)
+    if (current.quality.kernel == HexagonKernel::RhombiSum)
         renderRhombi(useTiles);
     else
         renderMcIntosh(useTiles);
-    timings.renderMs = msSince(start);
+    current.timings.renderMs = msSince(start);
     rendered = true;
 }
 
@@ -664,14 +759,14 @@ Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, f
             p.ensureDiagonals();
         p.timer.begin(ViewPass::kName);
         if (view == View::Depth) {
-            const float lo = p.nearestDepth, hi = p.farthestDepth;
+            const float lo = p.current.nearestDepth, hi = p.current.farthestDepth;
             low = std::max(lo, 1e-3f);
             high = std::max(hi, lo * 1.01f + 1e-3f);
-            p.viewPass.run(p.depth, ViewPass::Mode::Depth, low, high, out.framebuffer);
+            p.viewPass.run(p.current.depth, ViewPass::Mode::Depth, low, high, out.framebuffer);
         } else if (view == View::Coc) {
             // The lens' CoC in the target's pixels; the target holds the gather's.
-            high = p.maxCocPx / static_cast<float>(1 << p.blurShift);
-            p.viewPass.run(p.coc.texture, ViewPass::Mode::Coc, 0.0f, high * p.gatherScale, out.framebuffer);
+            high = p.current.maxCocPx / static_cast<float>(1 << p.blurShift);
+            p.viewPass.run(p.coc.texture, ViewPass::Mode::Coc, 0.0f, high * p.current.gatherScale, out.framebuffer);
         } else {
             p.viewPass.run(p.target(view).texture, ViewPass::Mode::Color, 0.0f, 0.0f, out.framebuffer);
         }
@@ -680,16 +775,16 @@ Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, f
         p.timer.end();
     if (view == View::Composite && p.plan.highlightSprites) {
         p.timer.begin(HighlightSpritePass::kName);
-        p.highlightSpritePass.draw(p.depth, out.framebuffer);
+        p.highlightSpritePass.draw(p.current.depth, out.framebuffer);
         p.timer.end();
         // The light the CoC pass held back from pixels in focus goes back (sprites never run at
         // quarter size).
         p.timer.begin(InFocusLightPass::kName);
-        const bool half = p.quality.targetFormat == TargetFormat::Rgba16F;
-        p.inFocusLightPass.run({p.colorTexture, p.depth, p.coc.texture, p.plan.nearField ? &p.nearDiameter : nullptr},
-                               CocPass::uniforms(p.coefficients, half, static_cast<float>(p.plan.highlightGain),
+        const bool half = p.current.quality.targetFormat == TargetFormat::Rgba16F;
+        p.inFocusLightPass.run({p.current.colorTexture, p.current.depth, p.coc.texture, p.plan.nearField ? &p.nearDiameter : nullptr},
+                               CocPass::uniforms(p.current.coefficients, half, static_cast<float>(p.plan.highlightGain),
                                                  HighlightSpritePass::kThreshold),
-                               p.directions, p.quality.samples, p.tileSize(),
+                               p.current.directions, p.current.quality.samples, p.tileSize(),
                                p.blurShift, p.frameHighlightTiles, out.framebuffer);
         p.timer.end();
     }
@@ -699,13 +794,13 @@ Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, f
 
 void Pipeline::Impl::finishTimings(Clock::time_point readStart)
 {
-    timings.readbackMs = msSince(readStart);
-    timings.gpu.clear();
+    current.timings.readbackMs = msSince(readStart);
+    current.timings.gpu.clear();
     for (auto& [name, ms] : timer.swap())
-        timings.gpu.push_back({name, ms});
-    timings.gpuFrame = gpuFrameIndex;
-    gpuFrameIndex = frameIndex;
-    timings.totalMs = msSince(frameStart);
+        current.timings.gpu.push_back({name, ms});
+    current.timings.gpuFrame = gpuFrameIndex;
+    gpuFrameIndex = current.frameIndex;
+    current.timings.totalMs = msSince(current.frameStart);
 }
 
 namespace {
@@ -780,7 +875,7 @@ cv::Mat Pipeline::read(View view, Encoding encoding)
 {
     PendingRead pending = readAsync(view, encoding);
     cv::Mat image = collect(pending);
-    impl_->timings = pending.timings();
+    impl_->current.timings = pending.timings();
     return image;
 }
 
@@ -798,14 +893,14 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
     if (view == View::Composite && !p.rendered) {
         // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
         // CoC pass's clean-up (no NaN, no negatives, within the target's range).
-        const bool srgbInput = p.color.depth() == CV_8U;
+        const bool srgbInput = p.current.color.depth() == CV_8U;
         const cv::Mat linear = srgbInput ? cv::Mat()
-                                         : sanitizeLinear(p.color, CocPass::largestColor(
-                                                                        p.quality.targetFormat == TargetFormat::Rgba16F));
-        read.ready = passThrough(p.color, linear, encoding);
-        p.timings.readbackMs = msSince(start);
-        p.timings.totalMs = msSince(p.frameStart);
-        read.timings = p.timings;
+                                         : sanitizeLinear(p.current.color, CocPass::largestColor(
+                                                                        p.current.quality.targetFormat == TargetFormat::Rgba16F));
+        read.ready = passThrough(p.current.color, linear, encoding);
+        p.current.timings.readbackMs = msSince(start);
+        p.current.timings.totalMs = msSince(p.current.frameStart);
+        read.timings = p.current.timings;
         return pending;
     }
     const Target& out = p.renderOutput(view, encoding, read.low, read.high);
@@ -816,7 +911,7 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
     read.buffer.readPixels(out.framebuffer.id(), p.size.width, p.size.height, CV_MAT_CN(type) == 4 ? GL_BGRA : GL_BGR,
                            CV_MAT_DEPTH(type) == CV_32F ? GL_FLOAT : GL_UNSIGNED_BYTE);
     p.finishTimings(start);
-    read.timings = p.timings;
+    read.timings = p.current.timings;
     return pending;
 }
 
@@ -887,17 +982,17 @@ cv::Mat Pipeline::readTarget(View view)
 const cv::Mat& Pipeline::filledDepth()
 {
     Impl& p = *impl_;
-    if (!p.depthPrepared)
-        p.prepareDepthAndPlan();
-    if (!p.preparedOnCpu) {
-        p.prepared.metres.create(p.size, CV_32FC1);
+    if (!p.current.depthPrepared)
+        p.planFrame();
+    if (!p.current.preparedOnCpu) {
+        p.current.prepared.metres.create(p.size, CV_32FC1);
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
-        glGetTextureImage(p.depth.id(), 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(p.prepared.metres.total() * 4),
-                          p.prepared.metres.data);
-        p.prepared.invalidFraction = p.invalidFraction;
-        p.preparedOnCpu = true;
+        glGetTextureImage(p.current.depth.id(), 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(p.current.prepared.metres.total() * 4),
+                          p.current.prepared.metres.data);
+        p.current.prepared.invalidFraction = p.current.invalidFraction;
+        p.current.preparedOnCpu = true;
     }
-    return p.prepared.metres;
+    return p.current.prepared.metres;
 }
 
 void Pipeline::prepareOnGpu(bool on)
@@ -907,13 +1002,13 @@ void Pipeline::prepareOnGpu(bool on)
 
 double Pipeline::invalidDepthFraction() const
 {
-    return impl_->invalidFraction;
+    return impl_->current.invalidFraction;
 }
 
 
 const FrameTimings& Pipeline::timings() const
 {
-    return impl_->timings;
+    return impl_->current.timings;
 }
 
 std::vector<PassTime> Pipeline::drainGpuTimes()

@@ -83,6 +83,22 @@ public:
     /// `quality` must have passed validate(). The frame's images are referenced, not copied,
     /// until the next process(): leave them unchanged until read() has been called.
     void process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality);
+    /// process() in two halves, so that a frame's upload and measurement go ahead of the passes
+    /// of the frame before it: begin() takes `frame`, uploads it and submits its depth prep and
+    /// scene measurement (on the GPU; on the CPU it does them); finish() takes the oldest frame
+    /// begun, plans it from its own measurement (waiting for the GPU only where it has not made
+    /// it yet) and runs its passes, after which the reads and accessors are of it. Begun frames
+    /// wait in order, each with its own textures; the reads stay of the frame finished last
+    /// until the next finish(). begin(N + 1); finish() (of N) keeps the GPU busy with the
+    /// passes of N - 1 while the CPU plans N. The same output as process(). With frames begun,
+    /// the GPU timer scopes of their depth prep and measurement go with the timings of the frame
+    /// read before them. The images are referenced until the frame's passes have run.
+    void begin(const Frame& frame, const LensSettings& lens, const QualitySettings& quality);
+    void finish();
+    /// Frames begun and not finished.
+    std::size_t begun() const;
+    /// Forgets the frames begun and not finished.
+    void dropBegun();
     /// Renders `view` of the last processed frame and reads it back. Depth and CoC views carry a
     /// legend along their bottom edge.
     cv::Mat read(View view, Encoding encoding);

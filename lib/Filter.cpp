@@ -205,6 +205,10 @@ struct Filter::Impl {
     LensSettings lastLens;
     /// submit()'s frames on their way back, oldest first, each with its report.
     struct InFlight {
+        std::size_t index = 0; ///< the frame's number, for its report
+        View view = View::Composite; ///< as the settings were at submit()
+        Encoding encoding = Encoding::Srgb8;
+        bool finished = false; ///< its passes run and its read queued (read, report)
         PendingRead read;
         FrameReport report;
     };
@@ -225,6 +229,15 @@ struct Filter::Impl {
     void submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
     /// receive() of a frame in flight (there must be one).
     cv::Mat receiveFrame();
+    /// The pipeline's oldest begun frame (`entry`'s) planned and its passes run, its read queued.
+    void finishFrame(InFlight& entry);
+    /// The frames in flight dropped, in the pipeline too (the context must be current).
+    void dropInFlight()
+    {
+        inFlight.clear();
+        if (pipeline)
+            pipeline->dropBegun();
+    }
 
     /// The context current on the calling thread until the end of the call, whichever thread
     /// used the Filter before; then what was current there before is again. On the caller's
@@ -250,7 +263,7 @@ struct Filter::Impl {
     {
         try {
             const auto bound = current();
-            inFlight.clear();
+            dropInFlight();
             pipeline.reset();
         } catch (const Error&) {
             // Another thread is inside a call on this Filter (a caller's bug): the GL objects
@@ -473,16 +486,37 @@ void Filter::Impl::processFrame(const cv::Mat& color, const cv::Mat& depth, doub
 void Filter::Impl::submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
 {
     const auto bound = current();
-    processFrame(color, depth, timestampS);
-    InFlight entry{pipeline->readAsync(toView(settings.view), toEncoding(settings.output)), {}};
-    fillReport(frames++, entry.read.timings(), entry.report);
+    LensSettings frameLens;
+    Frame frame = admit(color, depth, timestampS, frameLens);
+    pipeline->begin(frame, frameLens, quality);
+    lastFrame = std::move(frame);
+    lastLens = frameLens;
+    // The frame submitted before goes on now, behind this one's upload and measurement: the GPU
+    // runs its passes while the CPU plans it, and measures this one meanwhile.
+    for (InFlight& entry : inFlight)
+        if (!entry.finished)
+            finishFrame(entry);
+    InFlight entry;
+    entry.index = frames++;
+    entry.view = toView(settings.view);
+    entry.encoding = toEncoding(settings.output);
     inFlight.push_back(std::move(entry));
+}
+
+void Filter::Impl::finishFrame(InFlight& entry)
+{
+    pipeline->finish();
+    entry.read = pipeline->readAsync(entry.view, entry.encoding);
+    fillReport(entry.index, entry.read.timings(), entry.report);
+    entry.finished = true;
 }
 
 cv::Mat Filter::Impl::receiveFrame()
 {
     const auto bound = current();
     InFlight& oldest = inFlight.front();
+    if (!oldest.finished)
+        finishFrame(oldest);
     cv::Mat image = pipeline->collect(oldest.read);
     report = std::move(oldest.report);
     report.timings.readbackMs = oldest.read.timings().readbackMs;
@@ -538,7 +572,7 @@ void Filter::reset()
     Impl& p = *impl_;
     if (!p.inFlight.empty()) {
         const auto bound = p.current();
-        p.inFlight.clear();
+        p.dropInFlight();
     }
     p.frames = 0;
     p.lastFrame.reset();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -205,6 +206,49 @@ TEST_P(DepthPrepOnGpu, FrameOutIsTheCpusOnTheTumClip)
     cv::minMaxLoc(difference.reshape(1), nullptr, &largest);
     EXPECT_LE(largest, 1.0);
     EXPECT_LE(cv::countNonZero(difference.reshape(1)), static_cast<int>(difference.total() / 1000));
+}
+
+// Defects caught: a frame begun ahead overwriting the textures, measurement or settings of the
+// frame before it (one set of textures for both, the measurement buffer shared), finish()
+// taking the newest frame instead of the oldest, the all-in-focus exit of one frame leaking into
+// the next. Frames begun one ahead (begin N + 1, finish N, read N: what Filter::submit() does)
+// give the bytes one frame at a time gives, with depth prep on the GPU and on the CPU.
+TEST_P(DepthPrepOnGpu, FramesBegunAheadGiveTheSerialFrames)
+{
+    auto source = openSource({test::dataDir() / "tum_fr1_rpy", std::nullopt, std::nullopt});
+    std::vector<Frame> frames;
+    while (auto frame = source->next())
+        if (frames.size() < 4)
+            frames.push_back(*frame);
+    ASSERT_EQ(frames.size(), 4u);
+    frames[2].depth = cv::Mat(frames[2].depth.size(), CV_32F, cv::Scalar(1.0f)); // all in focus at 1 m
+    const auto lensOf = [](std::size_t i) {
+        LensSettings lens = tumLens();
+        lens.focusM = i % 2 == 0 ? 1.0 : 1.5;
+        return lens;
+    };
+    for (const bool onGpu : {true, false}) {
+        Pipeline serial, ahead;
+        serial.prepareOnGpu(onGpu);
+        ahead.prepareOnGpu(onGpu);
+        std::vector<cv::Mat> expected;
+        for (std::size_t i = 0; i < frames.size(); ++i)
+            expected.push_back(serial.run(frames[i], lensOf(i), GetParam().quality));
+        std::vector<cv::Mat> got;
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+            ahead.begin(frames[i], lensOf(i), GetParam().quality);
+            if (ahead.begun() == 2) {
+                ahead.finish();
+                got.push_back(ahead.read(View::Composite, Encoding::Srgb8));
+            }
+        }
+        ahead.finish();
+        got.push_back(ahead.read(View::Composite, Encoding::Srgb8));
+        ASSERT_EQ(got.size(), expected.size());
+        for (std::size_t i = 0; i < got.size(); ++i)
+            EXPECT_EQ(cv::norm(got[i], expected[i], cv::NORM_INF), 0.0)
+                << (onGpu ? "GPU" : "CPU") << " depth prep, frame " << i;
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, DepthPrepOnGpu, ::testing::ValuesIn(test::presetsAndKernels()),

@@ -27,6 +27,12 @@ struct Tile {
 };
 static_assert(sizeof(Header) == 48 && sizeof(Tile) == 16);
 
+cv::Size tilesOf(cv::Size frame)
+{
+    constexpr int T = SceneAnalysis::kTileSize;
+    return {(frame.width + T - 1) / T, (frame.height + T - 1) / T};
+}
+
 } // namespace
 
 SceneMeasurePass::SceneMeasurePass()
@@ -44,17 +50,14 @@ SceneMeasurePass::SceneMeasurePass()
 }
 
 void SceneMeasurePass::run(const gl::Texture& depth, const gl::Texture& color, bool eightBit,
-                           const CocCoefficients& k, const gl::Texture* measured)
+                           const CocCoefficients& k, const gl::Texture* measured, gl::StorageBuffer& out)
 {
-    constexpr int T = SceneAnalysis::kTileSize;
-    frame_ = {depth.width(), depth.height()};
-    tiles_ = {(frame_.width + T - 1) / T, (frame_.height + T - 1) / T};
-    const auto bytes = static_cast<GLsizeiptr>(sizeof(Header) + tiles_.area() * sizeof(Tile));
-    if (buffer_.size() < bytes)
-        buffer_ = gl::StorageBuffer(bytes, "scene measurement");
+    const cv::Size tiles = tilesOf({depth.width(), depth.height()});
+    const auto bytes = static_cast<GLsizeiptr>(sizeof(Header) + tiles.area() * sizeof(Tile));
+    if (out.size() < bytes)
+        out = gl::StorageBuffer(bytes, "scene measurement");
     const Header zero{};
-    buffer_.update(&zero, sizeof zero);
-    everyPixelInvalid_ = measured == nullptr;
+    out.update(&zero, sizeof zero);
 
     const CocPass::Uniforms u = CocPass::uniforms(k, false, 1.0f);
     cocParams_.update(&u, sizeof u);
@@ -65,32 +68,34 @@ void SceneMeasurePass::run(const gl::Texture& depth, const gl::Texture& color, b
     bindTexture(0, depth.id(), nearest_.id());
     bindTexture(1, color.id(), nearest_.id());
     bindTexture(2, (measured ? *measured : depth).id(), nearest_.id());
-    buffer_.bind(0);
-    glDispatchCompute(static_cast<GLuint>(tiles_.width), static_cast<GLuint>(tiles_.height), 1);
+    out.bind(0);
+    glDispatchCompute(static_cast<GLuint>(tiles.width), static_cast<GLuint>(tiles.height), 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
-SceneMeasurement SceneMeasurePass::read(std::size_t& invalidPixels) const
+SceneMeasurement SceneMeasurePass::read(const gl::StorageBuffer& buffer, cv::Size frame, bool countedHoles,
+                                        std::size_t& invalidPixels)
 {
+    const cv::Size grid = tilesOf(frame);
     Header header{};
-    std::vector<Tile> tiles(static_cast<std::size_t>(tiles_.area()));
-    buffer_.read(&header, sizeof header);
-    glGetNamedBufferSubData(buffer_.id(), sizeof header, static_cast<GLsizeiptr>(tiles.size() * sizeof(Tile)),
+    std::vector<Tile> tiles(static_cast<std::size_t>(grid.area()));
+    buffer.read(&header, sizeof header);
+    glGetNamedBufferSubData(buffer.id(), sizeof header, static_cast<GLsizeiptr>(tiles.size() * sizeof(Tile)),
                             tiles.data());
-    invalidPixels = everyPixelInvalid_ ? static_cast<std::size_t>(frame_.area()) : header.invalidPixels;
+    invalidPixels = countedHoles ? header.invalidPixels : static_cast<std::size_t>(frame.area());
 
     SceneMeasurement m;
-    m.frame = frame_;
-    m.tiles = tiles_;
-    m.pixels = static_cast<std::size_t>(frame_.area());
+    m.frame = frame;
+    m.tiles = grid;
+    m.pixels = static_cast<std::size_t>(frame.area());
     for (std::size_t i = 0; i < m.histogram.size(); ++i)
         m.histogram[i] = static_cast<int>(header.bins[i]);
-    m.tileMinDepth.create(tiles_, CV_32F);
-    m.tileMaxDepth.create(tiles_, CV_32F);
-    m.tileHighlights.create(tiles_, CV_32S);
-    m.tileLuminance.create(tiles_, CV_32F);
-    for (int ty = 0, i = 0; ty < tiles_.height; ++ty)
-        for (int tx = 0; tx < tiles_.width; ++tx, ++i) {
+    m.tileMinDepth.create(grid, CV_32F);
+    m.tileMaxDepth.create(grid, CV_32F);
+    m.tileHighlights.create(grid, CV_32S);
+    m.tileLuminance.create(grid, CV_32F);
+    for (int ty = 0, i = 0; ty < grid.height; ++ty)
+        for (int tx = 0; tx < grid.width; ++tx, ++i) {
             const Tile& t = tiles[static_cast<std::size_t>(i)];
             m.tileMinDepth.at<float>(ty, tx) = t.minDepth;
             m.tileMaxDepth.at<float>(ty, tx) = t.maxDepth;

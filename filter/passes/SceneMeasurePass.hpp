@@ -25,20 +25,20 @@ public:
     /// CoC of `k`: `color` is float linear, or with `eightBit` the frame's sRGB bytes undecoded
     /// (GL_RGB8, a view of the CoC pass's sRGB8 texture: Texture::view()). `measured`:
     /// DepthPrepPass::measured(), whose holes are counted; nullptr for a frame without depth.
+    /// The measurement goes to `out`, made large enough; read() takes it from there.
     void run(const gl::Texture& depth, const gl::Texture& color, bool eightBit, const CocCoefficients& k,
-             const gl::Texture* measured);
-    /// Waits for the measurement and returns it, with the pixels of the depth that had no
-    /// measurement in `invalidPixels` (all of them for a frame without depth).
-    SceneMeasurement read(std::size_t& invalidPixels) const;
+             const gl::Texture* measured, gl::StorageBuffer& out);
+    /// Waits for the measurement run() put in `buffer`, of a frame of `frame` pixels, and returns
+    /// it, with the pixels of the depth that had no measurement in `invalidPixels` (all of them
+    /// where `countedHoles` is false: the frame had no depth).
+    static SceneMeasurement read(const gl::StorageBuffer& buffer, cv::Size frame, bool countedHoles,
+                                 std::size_t& invalidPixels);
 
 private:
     gl::Program program_;
     GLint eightBitLocation_ = -1, countHolesLocation_ = -1;
     gl::UniformBuffer cocParams_;
     gl::Sampler nearest_;
-    gl::StorageBuffer buffer_;
-    cv::Size frame_, tiles_;
-    bool everyPixelInvalid_ = false; ///< the last frame had no depth
 };
 
 } // namespace defocus

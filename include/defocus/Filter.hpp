@@ -211,12 +211,16 @@ public:
     void processTextures(const GlFrame& frame, double timestampS = 0.0);
 
     /// Frames in flight, for throughput (as FFmpeg's send/receive): submit() takes a frame as
-    /// process() does and returns once its passes and its read are queued, without waiting for
-    /// the GPU; receive() returns the oldest submitted frame's result, the bytes process() would
-    /// have returned for it, waiting for it, and makes lastFrame() that frame's report (its
-    /// totalMs and readbackMs: the time spent on it in both calls); nullopt when none is in
-    /// flight. With kFramesInFlight submitted before each receive(), the next frame's work on
-    /// the CPU (depth, analysis, upload) overlaps the GPU's work and read of the one before.
+    /// process() does, uploads it and queues its depth preparation and scene measurement, then
+    /// plans the frame submitted before it and queues its passes and its read, and returns
+    /// without waiting for the GPU's passes; receive() returns the oldest submitted frame's
+    /// result, the bytes process() would have returned for it (planning it first if no submit()
+    /// has), waiting for it, and makes lastFrame() that frame's report (its totalMs: from its
+    /// submit() to its receive(); readbackMs: the time spent reading it); nullopt when none is
+    /// in flight. With kFramesInFlight submitted before each receive(), the GPU measures a frame
+    /// and runs the passes of the one before while the CPU plans; the CPU's own work (upload,
+    /// or depth preparation on a software renderer) overlaps the GPU's. The images are
+    /// referenced until the frame is received: leave their pixels unchanged until then.
     /// Settings changed between submits apply from the next submit. While frames are in flight,
     /// process() and contactSheet() throw Error; reset() drops them. Not for a Filter on the
     /// caller's context (processTextures()).
