@@ -118,21 +118,30 @@ int printInfo(const Options& options)
     return kExitDone;
 }
 
-std::string summarise(std::size_t in, std::size_t out, const std::map<std::string, double>& passMs,
-                      double totalMs, double uploadMs, double readbackMs, std::size_t timed)
+/// GPU milliseconds summed per pass, in the order the passes first reported (the order they run).
+class PassTotals {
+public:
+    void add(const std::string& name, double ms)
+    {
+        const auto found = std::find_if(totals_.begin(), totals_.end(), [&](const auto& t) { return t.first == name; });
+        if (found == totals_.end())
+            totals_.emplace_back(name, ms);
+        else
+            found->second += ms;
+    }
+    const std::vector<std::pair<std::string, double>>& totals() const { return totals_; }
+
+private:
+    std::vector<std::pair<std::string, double>> totals_;
+};
+
+std::string summarise(std::size_t in, std::size_t out, const PassTotals& passMs, double totalMs, double uploadMs,
+                      double readbackMs, std::size_t timed)
 {
     const double n = static_cast<double>(std::max<std::size_t>(timed, 1));
     std::string passes;
-    // Passes in the order they run; any other pass after them.
-    const std::vector<std::string> order{"coc",        "horizontal", "diagonal-a", "diagonal-b", "rhombi-1",
-                                         "rhombi-2",   "near-field", "composite",  "view"};
-    auto names = order;
-    for (const auto& [name, ms] : passMs)
-        if (std::find(order.begin(), order.end(), name) == order.end())
-            names.push_back(name);
-    for (const auto& name : names)
-        if (const auto found = passMs.find(name); found != passMs.end())
-            passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", name, found->second / n);
+    for (const auto& [name, ms] : passMs.totals())
+        passes += fmt::format("{}{} {:.1f}", passes.empty() ? "" : ", ", name, ms / n);
     return fmt::format("defocus: {} frames in, {} frames out, {:.1f} ms/frame (GPU per pass: {}; upload {:.1f}, "
                        "readback {:.1f} ms)",
                        in, out, totalMs / n, passes.empty() ? "n/a" : passes, uploadMs / n, readbackMs / n);
@@ -367,7 +376,7 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
     bool depthChecked = false;
     TimingLog timingLog;
     cv::Size frameSize;
-    std::map<std::string, double> passMs;
+    PassTotals passMs;
     double totalMs = 0, uploadMs = 0, readbackMs = 0;
     std::size_t framesIn = 0, timed = 0;
     cv::Mat sheet; // --contact-sheet's image, once its frame has passed
@@ -394,7 +403,7 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
         const Timings& t = done.timings;
         timingLog.frame(t, w.frame.index, done.index);
         for (const auto& pass : t.gpu)
-            passMs[pass.name] += pass.ms;
+            passMs.add(pass.name, pass.ms);
         totalMs += t.totalMs;
         uploadMs += t.uploadMs;
         readbackMs += t.readbackMs;
@@ -521,7 +530,7 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
     if (framesIn > 0)
         timingLog.gpu(lastGpu, filter.lastFrame().index);
     for (const auto& pass : lastGpu)
-        passMs[pass.name] += pass.ms;
+        passMs.add(pass.name, pass.ms);
     // The contact sheet and the timings stand under their names only when the run is done, as
     // the output does; --keep-partial keeps a failed or stopped run's under NAME.partial.EXT.
     const bool done = status == kExitDone && framesIn > 0;
