@@ -158,7 +158,11 @@ struct FrameContext {
     float fallbackDepth = 1.0f;
     std::size_t frameIndex = 0;
     FrameTimings timings;
-    Clock::time_point frameStart;
+    /// The time spent on the frame: begin()'s, then from finish() on (a frame begun ahead waits
+    /// between the two, which is not its time).
+    Clock::time_point frameStart, finishStart;
+    double beginMs = 0.0;
+    double spentMs() const { return beginMs + msSince(finishStart); }
 
     gl::Texture colorTexture;
     gl::Texture colorBytes;   ///< 8-bit frames: colorTexture's bytes, undecoded (SceneMeasurePass)
@@ -369,6 +373,7 @@ void Pipeline::begin(const Frame& frame, const LensSettings& lens, const Quality
         p.spare.pop_back();
     }
     p.begin(f, frame, lens, quality);
+    f.beginMs = msSince(f.frameStart);
     p.staged.push_back(std::move(f));
 }
 
@@ -438,6 +443,7 @@ void Pipeline::finish()
     p.spare.push_back(std::exchange(p.current, std::move(p.staged.front())));
     p.staged.pop_front();
     FrameContext& f = p.current;
+    f.finishStart = Clock::now();
     p.size = f.size;
     p.setBlurShift(f.quality.resolution == Resolution::Half ? 1 : 0);
     p.rendered = false;
@@ -800,7 +806,7 @@ void Pipeline::Impl::finishTimings(Clock::time_point readStart)
         current.timings.gpu.push_back({name, ms});
     current.timings.gpuFrame = gpuFrameIndex;
     gpuFrameIndex = current.frameIndex;
-    current.timings.totalMs = msSince(current.frameStart);
+    current.timings.totalMs = current.spentMs();
 }
 
 namespace {
@@ -899,7 +905,7 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
                                                                         p.current.quality.targetFormat == TargetFormat::Rgba16F));
         read.ready = passThrough(p.current.color, linear, encoding);
         p.current.timings.readbackMs = msSince(start);
-        p.current.timings.totalMs = msSince(p.current.frameStart);
+        p.current.timings.totalMs = p.current.spentMs();
         read.timings = p.current.timings;
         return pending;
     }

@@ -45,7 +45,9 @@ struct FrameTimings {
     double uploadMs = 0.0;    ///< colour + depth to textures
     double renderMs = 0.0;    ///< submitting the passes
     double readbackMs = 0.0;  ///< output pass + glReadPixels (waits for the GPU)
-    double totalMs = 0.0;     ///< process() + read(), wall clock
+    /// process() + read(), wall clock; for a frame begun ahead, begin() + finish() + read(), not
+    /// the wait between them.
+    double totalMs = 0.0;
     /// GPU time per pass of frame `gpuFrame`: timer queries are read one frame late so that
     /// they never stall; empty on the first frame and when the driver has no timers.
     std::vector<PassTime> gpu;

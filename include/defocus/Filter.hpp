@@ -215,9 +215,9 @@ public:
     /// plans the frame submitted before it and queues its passes and its read, and returns
     /// without waiting for the GPU's passes; receive() returns the oldest submitted frame's
     /// result, the bytes process() would have returned for it (planning it first if no submit()
-    /// has), waiting for it, and makes lastFrame() that frame's report (its totalMs: from its
-    /// submit() to its receive(); readbackMs: the time spent reading it); nullopt when none is
-    /// in flight. With kFramesInFlight submitted before each receive(), the GPU measures a frame
+    /// has), waiting for it, and makes lastFrame() that frame's report (its totalMs and
+    /// readbackMs: the time spent on it in its submit(), the next and receive(), not the time
+    /// it waited between them); nullopt when none is in flight. With kFramesInFlight submitted before each receive(), the GPU measures a frame
     /// and runs the passes of the one before while the CPU plans; the CPU's own work (upload,
     /// or depth preparation on a software renderer) overlaps the GPU's. The images are
     /// referenced until the frame is received: leave their pixels unchanged until then.
