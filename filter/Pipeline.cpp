@@ -21,6 +21,7 @@
 #include "filter/Views.hpp"
 #include "filter/gl/GpuTimer.hpp"
 #include "filter/gl/Objects.hpp"
+#include "filter/gl/UploadRing.hpp"
 #include "filter/passes/CocPass.hpp"
 #include "filter/passes/CompositePass.hpp"
 #include "filter/passes/CopyPass.hpp"
@@ -189,6 +190,9 @@ struct FrameContext {
 
 struct Pipeline::Impl {
     gl::VertexArray vao = gl::VertexArray::create();
+    /// The frames' pixels on their way up where the GPU prepares depth: 2 uploads a frame, for
+    /// up to 3 frames queued.
+    gl::UploadRing uploads{6, "upload ring"};
     DepthPrepPass depthPrepPass;
     SceneMeasurePass sceneMeasurePass;
     CocPass cocPass;
@@ -274,15 +278,19 @@ struct Pipeline::Impl {
             rhombiSecondPass(nullptr);
     }
     void uploadNearDiameter();
-    /// `f`'s colour into its colorTexture (and its bytes' view).
-    static void uploadColor(FrameContext& f)
+    /// `f`'s colour into its colorTexture (and its bytes' view), through `ring` or straight.
+    static void uploadColor(FrameContext& f, gl::UploadRing* ring)
     {
         const bool srgbInput = f.color.depth() == CV_8U;
         if (ensureTexture(f.colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, f.size, "input colour"))
             f.colorBytes = srgbInput ? gl::Texture::view(f.colorTexture, GL_RGB8, "input colour, bytes") : gl::Texture();
         // BGRx goes up as it is: the texture has no alpha, so the fourth byte is dropped on the way.
-        f.colorTexture.upload(f.color.channels() == 4 ? GL_BGRA : GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT,
-                              f.color.data);
+        const GLenum format = f.color.channels() == 4 ? GL_BGRA : GL_BGR;
+        const GLenum type = srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT;
+        if (ring)
+            ring->upload(f.colorTexture, format, type, f.color.data, f.color.total() * f.color.elemSize());
+        else
+            f.colorTexture.upload(format, type, f.color.data);
     }
     /// begin()'s work on `f`: the frame, its settings, the all-in-focus exit or depth prep.
     void begin(FrameContext& f, const Frame& frame, const LensSettings& lens, const QualitySettings& quality);
@@ -476,13 +484,13 @@ void Pipeline::Impl::prepare(FrameContext& f)
         // The frame's pixels go up as they came; only the measurement comes back, read when the
         // frame is planned (planFrame()), by when the GPU has long made it when a frame is in
         // flight before it.
-        uploadColor(f);
+        uploadColor(f, &uploads);
         ensureTexture(f.depth, GL_R32F, f.size, "filled depth");
         f.hasDepth = !f.depthInput.empty();
         const cv::Mat given = f.depthInput.isContinuous() ? f.depthInput : f.depthInput.clone();
         if (f.hasDepth) {
             ensureTexture(f.depthAsGiven, GL_R32F, given.size(), "depth as given");
-            f.depthAsGiven.upload(GL_RED, GL_FLOAT, given.data);
+            uploads.upload(f.depthAsGiven, GL_RED, GL_FLOAT, given.data, given.total() * given.elemSize());
         }
         f.timings.uploadMs = msSince(start);
         start = Clock::now();
@@ -507,7 +515,8 @@ void Pipeline::Impl::prepare(FrameContext& f)
 
         start = Clock::now();
         ensureTexture(f.depth, GL_R32F, f.size, "filled depth");
-        uploadColor(f);
+        // Straight: on a software renderer a ring's copy would come on top of the driver's own.
+        uploadColor(f, nullptr);
         CV_Assert(f.prepared.metres.isContinuous());
         f.depth.upload(GL_RED, GL_FLOAT, f.prepared.metres.data);
         f.timings.uploadMs = msSince(start);
