@@ -6,10 +6,11 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <deque>
 #include <mutex>
-#include <utility>
 #include <string_view>
+#include <utility>
 
 #include <epoxy/gl.h>
 #include <opencv2/imgproc.hpp>
@@ -18,6 +19,7 @@
 #include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
+#include "filter/Log.hpp"
 #include "filter/Views.hpp"
 #include "filter/gl/GpuTimer.hpp"
 #include "filter/gl/Objects.hpp"
@@ -137,6 +139,20 @@ bool softwareRenderer()
            renderer.find("Software Rasterizer") != std::string_view::npos;
 }
 
+/// Where depth prep runs unless told: DEFOCUS_DEPTH_PREP=gpu or cpu, for tests and profiling (the
+/// whole test suite on either path on any renderer); otherwise the CPU on a software renderer
+/// (softwareRenderer()) and the GPU on any other.
+bool defaultPrepareOnGpu()
+{
+    const char* chosen = std::getenv("DEFOCUS_DEPTH_PREP");
+    const std::string_view value = chosen ? chosen : "";
+    if (value == "gpu" || value == "cpu")
+        return value == "gpu";
+    if (!value.empty())
+        logger().warn("DEFOCUS_DEPTH_PREP='{}' is neither 'gpu' nor 'cpu': ignored", value);
+    return !softwareRenderer();
+}
+
 } // namespace
 
 /// One frame from begin() until the one after it is begun: its images and settings, what they
@@ -234,9 +250,9 @@ struct Pipeline::Impl {
     cv::Size blurSize; ///< the blur passes': the frame's, or half or a quarter of it (Resolution::Half)
     int blurShift = 0; ///< log2 of size / blurSize (the plan's FramePlan::blurShift)
     /// Depth prep and the scene measurement on the GPU (DepthPrepPass, SceneMeasurePass), or
-    /// on the CPU (prepareDepth(), measureScene()) with the filled depth uploaded: the CPU on a
-    /// software renderer (softwareRenderer()), the GPU on any other.
-    bool prepareOnGpu = !softwareRenderer();
+    /// on the CPU (prepareDepth(), measureScene()) with the filled depth uploaded
+    /// (defaultPrepareOnGpu()).
+    bool prepareOnGpu = defaultPrepareOnGpu();
     DepthPrepWorkspace depthWorkspace; // prepareDepth()'s buffers, kept from frame to frame
     /// Readback buffers collected and free again, for the next reads of their size.
     std::vector<gl::ReadbackBuffer> spareReadbacks;
