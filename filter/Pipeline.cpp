@@ -139,9 +139,9 @@ bool softwareRenderer()
            renderer.find("Software Rasterizer") != std::string_view::npos;
 }
 
-/// Where depth prep runs unless told: DEFOCUS_DEPTH_PREP=gpu or cpu, for tests and profiling (the
-/// whole test suite on either path on any renderer); otherwise the CPU on a software renderer
-/// (softwareRenderer()) and the GPU on any other.
+/// Where depth prep runs unless told: DEFOCUS_DEPTH_PREP=gpu or cpu, for tests and profiling (CI
+/// runs the library's and the element's suites on the GPU's path on llvmpipe); otherwise the CPU
+/// on a software renderer (softwareRenderer()) and the GPU on any other.
 bool defaultPrepareOnGpu()
 {
     const char* chosen = std::getenv("DEFOCUS_DEPTH_PREP");

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// The depth-of-field pipeline for one frame: a frame whose valid depths all give less than half a
+// The depth-of-field pipeline, a frame at a time or one begun ahead: a frame whose valid depths all give less than half a
 // pixel of CoC is passed through before anything else; otherwise upload, depth hole filling and
 // the scene measurement (on the GPU, or on the CPU on a software renderer: prepareOnGpu()), the
 // analysis and the per-frame plan (which tiles blur, which are copied, whether
@@ -9,7 +9,9 @@
 // that puts the frame's in-focus pixels back), bokeh sprites for lights above white in the
 // aperture's exact shape (any blade count, the circle, squeezed: filter/Aperture.hpp; the gather's
 // hexagon is squeezed as the aperture is and covers its area), and the view read back. Owns every
-// intermediate target and reallocates them only when size or format changes.
+// intermediate target and reallocates them only when size or format changes; each frame's own
+// textures and measurement live in a frame context, so that the next frame can be uploaded and
+// measured (begin()) before this one's passes run (finish()).
 // Needs a current GL 4.5 context (gl::EglContext) for its whole life.
 #pragma once
 
