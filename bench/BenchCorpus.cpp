@@ -105,14 +105,16 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
         for (const Preset& preset : presets())
             chosen.push_back({std::string(preset.name), preset});
     for (const std::string& label : options.presets) {
-        // NAME, then any of :quarter, :half-only and :no-sprites.
+        // NAME, then any of :quarter, :half-only, :no-sprites, :16f and :32f.
         std::string_view name = label;
-        bool quarter = false, halfOnly = false, noSprites = false;
+        bool quarter = false, halfOnly = false, noSprites = false, half = false, full = false;
         for (bool found = true; found;) {
             found = false;
             for (const auto& [suffix, flag] : {std::pair<std::string_view, bool*>{":quarter", &quarter},
                                                std::pair<std::string_view, bool*>{":half-only", &halfOnly},
-                                               std::pair<std::string_view, bool*>{":no-sprites", &noSprites}})
+                                               std::pair<std::string_view, bool*>{":no-sprites", &noSprites},
+                                               std::pair<std::string_view, bool*>{":16f", &half},
+                                               std::pair<std::string_view, bool*>{":32f", &full}})
                 if (name.ends_with(suffix)) {
                     name.remove_suffix(suffix.size());
                     *flag = found = true;
@@ -123,6 +125,8 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
             p.settings.quarterOnLargeBlur = quarter && !halfOnly;
         if (noSprites)
             p.settings.highlightSprites = false;
+        if (half || full)
+            p.settings.precision = half ? TargetFormat::Rgba16F : TargetFormat::Rgba32F;
         chosen.push_back({label, p});
     }
     // Every scene is read and checked before the first is measured: a bad folder fails at once.
