@@ -35,6 +35,7 @@
 #include "filter/Presets.hpp"
 #include "filter/Settings.hpp"
 #include "filter/gl/EglContext.hpp"
+#include "filter/gl/Renderer.hpp"
 #include "samples/BenchMachine.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
@@ -411,7 +412,9 @@ int run(const Options& options, const std::string& commandLine)
     quality.adaptive = !options.noAdaptive;
     if (options.quarterOnLargeBlur)
         quality.quarterOnLargeBlur = true;
-    const std::string precision = quality.targetFormat == TargetFormat::Rgba32F ? "32f" : "16f";
+    const std::string precision = quality.targetFormat == TargetFormat::Rgba32F   ? "32f"
+                                  : quality.targetFormat == TargetFormat::Rgba16F ? "16f"
+                                                                                  : "auto";
     LensSettings baseLens;
     baseLens.model = CocModel::ThinLens;
     baseLens.focusM = options.focusM;
@@ -465,7 +468,10 @@ int run(const Options& options, const std::string& commandLine)
                quality.nearField ? " + near field" : "",
                quality.resolution == Resolution::Half && quality.quarterOnLargeBlur ? "half (quarter on large blur)"
                                                                                     : resolutionName(quality.resolution),
-               precision == "32f" ? "RGBA32F" : "RGBA16F",
+               precision == "32f"   ? "RGBA32F"
+               : precision == "16f" ? "RGBA16F"
+                                    : (gl::isSoftwareRenderer(info.glRenderer) ? "RGBA32F (the renderer's)"
+                                                                             : "RGBA16F (the renderer's)"),
                quality.adaptive ? "adaptive (in-focus frames and tiles skipped)" : "every pass on every pixel",
                options.runs, options.warmup);
     fmt::print("lens: thin lens {} mm f/{} focused at {} m, 36 mm sensor, max-coc {} px per 640 px of width\n",

@@ -510,7 +510,9 @@ int replot(const Options& options)
             throw std::runtime_error(fmt::format("{}: unknown method {}", options.replot, result.at("method").dump()));
         row.settings.samples = result.at("samples").get<int>();
         row.settings.resolution = result.at("resolution") == "half" ? Resolution::Half : Resolution::Full;
-        row.settings.precision = result.at("precision") == "32F" ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
+        row.settings.precision = result.at("precision") == "32F"    ? TargetFormat::Rgba32F
+                                 : result.at("precision") == "auto" ? TargetFormat::Auto
+                                                                    : TargetFormat::Rgba16F;
         row.shortLabel = shortLabel(*row.info, row.settings);
         row.error.psnrLinear = result.at("error").at("psnrLinearDb").get<double>();
         row.wallMs = {result.at("wallMsMedian").get<double>()};
@@ -823,7 +825,8 @@ int main(int argc, char** argv)
     app.add_option("--presets", presetList,
                    "scene folders only: comma-separated presets to run (default: all); NAME:quarter runs "
                    "preset NAME with quarter size on large blur, NAME:half-only without (the presets' own), "
-                   "NAME:no-sprites without bokeh sprites (they combine: NAME:no-sprites:quarter)");
+                   "NAME:no-sprites without bokeh sprites, NAME:16f and NAME:32f with half- or full-float "
+                   "targets (they combine: NAME:no-sprites:quarter)");
     app.add_option("--scale", corpus.scale,
                    "scene folders only: enlarge every scene by this factor (colour and truth bilinear, depth "
                    "nearest, lens unchanged: the CoC in pixels grows with it), to judge large frames' blur")

@@ -100,7 +100,11 @@ Quality resolveQuality(const Quality& quality)
     Quality out = quality;
     out.samples = q.samples;
     out.hexagon = q.kernel == HexagonKernel::McIntoshMin ? Quality::Hexagon::McIntosh : Quality::Hexagon::Rhombi;
-    out.precision = q.targetFormat == TargetFormat::Rgba32F ? Quality::Precision::F32 : Quality::Precision::F16;
+    // The preset's own precision is the renderer's: it stays unset.
+    if (q.targetFormat == TargetFormat::Auto)
+        out.precision.reset();
+    else
+        out.precision = q.targetFormat == TargetFormat::Rgba32F ? Quality::Precision::F32 : Quality::Precision::F16;
     out.resolution = q.resolution == Resolution::Half ? Quality::Resolution::Half : Quality::Resolution::Full;
     out.nearField = q.nearField;
     return out;

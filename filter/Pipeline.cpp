@@ -23,6 +23,7 @@
 #include "filter/Views.hpp"
 #include "filter/gl/GpuTimer.hpp"
 #include "filter/gl/Objects.hpp"
+#include "filter/gl/Renderer.hpp"
 #include "filter/gl/UploadRing.hpp"
 #include "filter/passes/CocPass.hpp"
 #include "filter/passes/CompositePass.hpp"
@@ -134,9 +135,7 @@ double validDepthRange(const cv::Mat& depth, float& lo, float& hi)
 bool softwareRenderer()
 {
     const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    const std::string_view renderer = name ? name : "";
-    return renderer.starts_with("llvmpipe") || renderer.starts_with("softpipe") ||
-           renderer.find("Software Rasterizer") != std::string_view::npos;
+    return gl::isSoftwareRenderer(name ? name : "");
 }
 
 /// Where depth prep runs unless told: DEFOCUS_DEPTH_PREP=gpu or cpu, for tests and profiling (CI
@@ -253,6 +252,8 @@ struct Pipeline::Impl {
     /// on the CPU (prepareDepth(), measureScene()) with the filled depth uploaded
     /// (defaultPrepareOnGpu()).
     bool prepareOnGpu = defaultPrepareOnGpu();
+    /// A software renderer (softwareRenderer()): TargetFormat::Auto is full float here.
+    const bool software = softwareRenderer();
     DepthPrepWorkspace depthWorkspace; // prepareDepth()'s buffers, kept from frame to frame
     /// Readback buffers collected and free again, for the next reads of their size.
     std::vector<gl::ReadbackBuffer> spareReadbacks;
@@ -423,6 +424,8 @@ void Pipeline::Impl::begin(FrameContext& f, const Frame& frame, const LensSettin
     f.color = frame.color;
     f.depthInput = frame.depth;
     f.quality = quality;
+    if (f.quality.targetFormat == TargetFormat::Auto)
+        f.quality.targetFormat = software ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
     f.aperture = ApertureShape::of(lens);
     // The gather's hexagon: the lens' for a hexagonal aperture; for other shapes a corner on top,
     // whose lines lie on the axes (a rotated hexagon's off-axis lines cost llvmpipe 8x as much).

@@ -19,7 +19,7 @@ QualitySettings rhombiNear(int samples, Resolution resolution)
     q.nearField = true;
     q.samples = samples;
     q.resolution = resolution;
-    q.targetFormat = TargetFormat::Rgba32F;
+    q.targetFormat = TargetFormat::Auto;
     q.adaptive = true;
     q.highlightSprites = true;
     q.quarterOnLargeBlur = false;
@@ -56,10 +56,10 @@ const std::vector<QualityPreset>& qualityPresets()
     // measures 30.55 dB (tests/AccuracyGLTest, docs/figures.md); the presets all use the rhombi,
     // which keep the hexagon, and a highlight's energy, from preset to preset.
     //
-    // 32F, not 16F: on llvmpipe the full-float targets ran as fast or faster in nearly every row
-    // at the same accuracy (within 0.01 dB), half floats being converted in software on every
-    // fetch and store. On a GPU 16F halves the bandwidth and will likely be the faster;
-    // re-measure there.
+    // The renderer's precision (TargetFormat::Auto): on llvmpipe the full-float targets ran as
+    // fast or faster in nearly every row, half floats being converted in software on every fetch
+    // and store; on an H100 half floats halved the passes' GPU time (1080p 2.66 -> 1.36 ms). The
+    // corpus measured both within 0.02 dB on every scene and preset (docs/benchmarks.md).
     //
     // Quarter size on large blur (QualitySettings::quarterOnLargeBlur) stays off in fast and
     // balanced: at 1920x1080 it took the balanced frame to 0.54 of its time, but on the corpus

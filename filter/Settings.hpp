@@ -71,7 +71,11 @@ struct LensSettings {
 /// Render-target precision of the intermediate passes.
 enum class TargetFormat {
     Rgba16F, ///< half float: enough for colour and a CoC in pixels, half the bandwidth
-    Rgba32F  ///< full float
+    Rgba32F, ///< full float
+    /// The renderer's: RGBA16F on a GPU, whose passes it halves the bandwidth of, RGBA32F on a
+    /// software renderer, which converts half floats on every fetch and store. The presets' (the
+    /// corpus measured both within 0.02 dB on every scene: docs/benchmarks.md).
+    Auto
 };
 
 /// The size the blur passes run at. The CoC pass, the scene analysis and the output are always
@@ -110,7 +114,7 @@ std::string_view kernelName(HexagonKernel kernel); ///< "mcintosh", "rhombi"
 bool parseKernel(std::string_view name, HexagonKernel& kernel);
 
 /// The pipeline's defaults; the programs start from a preset instead (filter/Presets.hpp:
-/// balanced = rhombi, 6 taps, near field, 32F).
+/// balanced = rhombi, 6 taps, near field, the renderer's precision).
 struct QualitySettings {
     /// Taps per directional blur, [2, 64]: per centred segment (McIntosh), per one-sided line
     /// (rhombi; a line shorter than this many pixels takes one tap per pixel).

@@ -219,7 +219,7 @@ void addQualityOptions(CLI::App& app, Quality& quality, QualityNames& names)
                    "How the blurs make the hexagon: rhombi (three one-sided rhombi summed, keeps highlight energy) "
                    "or mcintosh (McIntosh et al. 2012, min of two) [default: from --quality]")
         ->check(CLI::IsMember({"rhombi", "mcintosh"}));
-    app.add_option("--precision", names.precision, "Intermediate render targets: 16f or 32f [default: from --quality]")
+    app.add_option("--precision", names.precision, "Intermediate render targets: 16f or 32f [default: the renderer's, 16f on a GPU, 32f on llvmpipe]")
         ->check(CLI::IsMember({"16f", "32f"}));
     app.add_option("--resolution", names.resolution,
                    "Size the blurs run at: full, or half (a quarter of the pixels; the output keeps the frame's "
@@ -249,7 +249,9 @@ void finishQuality(const CLI::App& app, QualityNames& names, Quality& q)
     if (app.count("--resolution") > 0)
         q.resolution = names.resolution == "half" ? Quality::Resolution::Half : Quality::Resolution::Full;
     q = resolve(q);
-    names.precision = *q.precision == Quality::Precision::F32 ? "32f" : "16f";
+    names.precision = !q.precision                                ? "auto"
+                      : *q.precision == Quality::Precision::F32 ? "32f"
+                                                                : "16f";
     names.kernel = *q.hexagon == Quality::Hexagon::McIntosh ? "mcintosh" : "rhombi";
     names.resolution = *q.resolution == Quality::Resolution::Half ? "half" : "full";
     names.nearField = *q.nearField;

@@ -451,15 +451,18 @@ TEST_F(CliFlags, SamplesSetTheTapsPerLine)
     EXPECT_GT(difference(two, twelve), 0.2);
 }
 
-// Defect: --precision ignored. The linear output of 16F targets differs from that of 32F ones,
-// and the preset's 32F is what runs without the option.
+// Defect: --precision ignored, or the preset's precision not the renderer's. The linear output
+// of 16F targets differs from that of 32F ones, and without the option the preset runs the
+// renderer's: 32F on a software renderer (llvmpipe), 16F on a GPU.
 TEST_F(CliFlags, PrecisionSetsTheTargetFormat)
 {
     const std::string lens = "--f-number 1.4 --max-coc 16";
     const cv::Mat preset = texture("near_far.png", lens, ".exr");
     const cv::Mat f32 = texture("near_far.png", lens + " --precision 32f", ".exr");
     const cv::Mat f16 = texture("near_far.png", lens + " --precision 16f", ".exr");
-    EXPECT_TRUE(identical(preset, f32));
+    const std::string info = defocus("--info").out;
+    const bool software = info.find("llvmpipe") != std::string::npos || info.find("softpipe") != std::string::npos;
+    EXPECT_TRUE(identical(preset, software ? f32 : f16)) << info;
     ASSERT_FALSE(f16.empty());
     EXPECT_GT(cv::norm(f16, f32, cv::NORM_INF), 0.0);
 }

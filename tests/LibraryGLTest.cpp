@@ -333,7 +333,8 @@ TEST_F(Library, RendererAndDevice)
 }
 
 // Defect caught: resolve() leaving fields empty (a report that says null where the filter ran
-// the preset's value), or overriding a field the caller set.
+// the preset's value), or overriding a field the caller set; or filling the precision, which
+// the presets leave to the renderer (half floats on a GPU, full on llvmpipe).
 TEST(LibrarySettings, ResolveFillsThePresetsValues)
 {
     defocus::Quality high;
@@ -342,13 +343,15 @@ TEST(LibrarySettings, ResolveFillsThePresetsValues)
     EXPECT_EQ(resolved.samples, 12);
     EXPECT_EQ(resolved.resolution, defocus::Quality::Resolution::Full);
     EXPECT_EQ(resolved.hexagon, defocus::Quality::Hexagon::Rhombi);
-    EXPECT_EQ(resolved.precision, defocus::Quality::Precision::F32);
+    EXPECT_FALSE(resolved.precision.has_value());
     EXPECT_EQ(resolved.nearField, true);
     defocus::Quality fast;
     fast.preset = defocus::Quality::Preset::Fast;
     fast.samples = 9;
     fast.nearField = false;
+    fast.precision = defocus::Quality::Precision::F16;
     const defocus::Quality mixed = defocus::resolve(fast);
+    EXPECT_EQ(mixed.precision, defocus::Quality::Precision::F16);
     EXPECT_EQ(mixed.samples, 9);
     EXPECT_EQ(mixed.nearField, false);
     EXPECT_EQ(mixed.resolution, defocus::Quality::Resolution::Half);

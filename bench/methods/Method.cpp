@@ -19,7 +19,7 @@ namespace defocus {
 
 std::string_view precisionName(TargetFormat format)
 {
-    return format == TargetFormat::Rgba16F ? "16F" : "32F";
+    return format == TargetFormat::Rgba16F ? "16F" : format == TargetFormat::Rgba32F ? "32F" : "auto";
 }
 
 std::string describe(const MethodInfo& info, const MethodSettings& settings)

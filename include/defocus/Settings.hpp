@@ -103,7 +103,8 @@ struct Quality {
     std::optional<int> samples;
     /// Default: the preset's (Rhombi).
     std::optional<Hexagon> hexagon;
-    /// Default: the preset's (F32).
+    /// Default: the preset's, the renderer's own: F16 on a GPU, F32 on a software renderer
+    /// (llvmpipe), where half floats are converted on every fetch and store.
     std::optional<Precision> precision;
     /// Default: the preset's.
     std::optional<Resolution> resolution;
@@ -183,7 +184,8 @@ inline constexpr double kDepthScale[] = {std::numeric_limits<double>::min(), std
 /// value out of range is replaced by the nearest allowed one (the messages say what was wrong).
 DEFOCUS_API std::vector<std::string> check(Settings& settings, bool clamp = false);
 
-/// `quality` with every field left empty set to its preset's value (what the filter runs).
+/// `quality` with every field left empty set to its preset's value (what the filter runs), but
+/// `precision`, which stays empty where the preset leaves it to the renderer.
 DEFOCUS_API Quality resolve(const Quality& quality);
 
 /// The library's version, "MAJOR.MINOR.PATCH".
