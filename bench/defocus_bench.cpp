@@ -470,8 +470,8 @@ int run(const Options& options, const std::string& commandLine)
                                                                                     : resolutionName(quality.resolution),
                precision == "32f"   ? "RGBA32F"
                : precision == "16f" ? "RGBA16F"
-                                    : (gl::isSoftwareRenderer(info.glRenderer) ? "RGBA32F (the renderer's)"
-                                                                             : "RGBA16F (the renderer's)"),
+                                    : (gl::halfFloatTargets(info.glRenderer) ? "RGBA16F (the renderer's)"
+                                                                           : "RGBA32F (the renderer's)"),
                quality.adaptive ? "adaptive (in-focus frames and tiles skipped)" : "every pass on every pixel",
                options.runs, options.warmup);
     fmt::print("lens: thin lens {} mm f/{} focused at {} m, 36 mm sensor, max-coc {} px per 640 px of width\n",

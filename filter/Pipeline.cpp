@@ -6,7 +6,6 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <deque>
 #include <mutex>
 #include <string_view>
@@ -19,7 +18,6 @@
 #include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
-#include "filter/Log.hpp"
 #include "filter/Views.hpp"
 #include "filter/gl/GpuTimer.hpp"
 #include "filter/gl/Objects.hpp"
@@ -128,28 +126,15 @@ double validDepthRange(const cv::Mat& depth, float& lo, float& hi)
     return depth.empty() ? 1.0 : static_cast<double>(invalid) / static_cast<double>(depth.total());
 }
 
-/// Mesa's software renderers. On llvmpipe, depth prep and the scene measurement cost more on
-/// its GPU than on the CPU: 8.7 and 34 ms a 640x480 frame against 1.5 and 1.3 (each pass's wall
-/// time, `defocus-bench --sizes 640x480 --versus-cpu-prep --finish-each-pass`), its fragment
-/// shaders paying 15 ns a pixel and its compute shaders' barriers more.
-bool softwareRenderer()
+/// GL_RENDERER of the current context. On llvmpipe, depth prep and the scene measurement cost
+/// more on its GPU than on the CPU: 8.7 and 34 ms a 640x480 frame against 1.5 and 1.3 (each
+/// pass's wall time, `defocus-bench --sizes 640x480 --versus-cpu-prep --finish-each-pass`), its
+/// fragment shaders paying 15 ns a pixel and its compute shaders' barriers more
+/// (gl::depthPrepOnGpu()).
+std::string_view rendererName()
 {
     const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    return gl::isSoftwareRenderer(name ? name : "");
-}
-
-/// Where depth prep runs unless told: DEFOCUS_DEPTH_PREP=gpu or cpu, for tests and profiling (CI
-/// runs the library's and the element's suites on the GPU's path on llvmpipe); otherwise the CPU
-/// on a software renderer (softwareRenderer()) and the GPU on any other.
-bool defaultPrepareOnGpu()
-{
-    const char* chosen = std::getenv("DEFOCUS_DEPTH_PREP");
-    const std::string_view value = chosen ? chosen : "";
-    if (value == "gpu" || value == "cpu")
-        return value == "gpu";
-    if (!value.empty())
-        logger().warn("DEFOCUS_DEPTH_PREP='{}' is neither 'gpu' nor 'cpu': ignored", value);
-    return !softwareRenderer();
+    return name ? name : "";
 }
 
 } // namespace
@@ -250,10 +235,10 @@ struct Pipeline::Impl {
     int blurShift = 0; ///< log2 of size / blurSize (the plan's FramePlan::blurShift)
     /// Depth prep and the scene measurement on the GPU (DepthPrepPass, SceneMeasurePass), or
     /// on the CPU (prepareDepth(), measureScene()) with the filled depth uploaded
-    /// (defaultPrepareOnGpu()).
-    bool prepareOnGpu = defaultPrepareOnGpu();
-    /// A software renderer (softwareRenderer()): TargetFormat::Auto is full float here.
-    const bool software = softwareRenderer();
+    /// (gl::depthPrepOnGpu()).
+    bool prepareOnGpu = gl::depthPrepOnGpu(rendererName());
+    /// TargetFormat::Auto: half floats here (gl::halfFloatTargets()).
+    const bool halfFloatTargets = gl::halfFloatTargets(rendererName());
     DepthPrepWorkspace depthWorkspace; // prepareDepth()'s buffers, kept from frame to frame
     /// Readback buffers collected and free again, for the next reads of their size.
     std::vector<gl::ReadbackBuffer> spareReadbacks;
@@ -425,7 +410,7 @@ void Pipeline::Impl::begin(FrameContext& f, const Frame& frame, const LensSettin
     f.depthInput = frame.depth;
     f.quality = quality;
     if (f.quality.targetFormat == TargetFormat::Auto)
-        f.quality.targetFormat = software ? TargetFormat::Rgba32F : TargetFormat::Rgba16F;
+        f.quality.targetFormat = halfFloatTargets ? TargetFormat::Rgba16F : TargetFormat::Rgba32F;
     f.aperture = ApertureShape::of(lens);
     // The gather's hexagon: the lens' for a hexagonal aperture; for other shapes a corner on top,
     // whose lines lie on the axes (a rotated hexagon's off-axis lines cost llvmpipe 8x as much).

@@ -24,6 +24,7 @@
 #include "filter/gl/CallerContext.hpp"
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
+#include "filter/gl/Renderer.hpp"
 
 #ifndef DEFOCUS_VERSION
 #error "DEFOCUS_VERSION is set by CMake from project(VERSION)"
@@ -131,8 +132,16 @@ namespace {
 
 RendererInfo toRendererInfo(const gl::ContextInfo& info)
 {
-    return {info.platform,  info.device,     info.eglVendor, info.eglVersion,
-            info.glVendor,  info.glRenderer, info.glVersion, info.timerQueries};
+    return {info.platform,
+            info.device,
+            info.eglVendor,
+            info.eglVersion,
+            info.glVendor,
+            info.glRenderer,
+            info.glVersion,
+            info.timerQueries,
+            gl::depthPrepOnGpu(info.glRenderer),
+            gl::halfFloatTargets(info.glRenderer)};
 }
 
 gl::ContextOptions toContextOptions(const ContextOptions& options)

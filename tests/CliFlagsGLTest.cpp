@@ -781,6 +781,22 @@ TEST_F(CliFlags, InfoPrintsThePlatformAndExits)
         EXPECT_NE(r.out.find(line), std::string::npos) << line << " in\n" << r.out;
 }
 
+// Defect: --info not saying where depth prep runs or the presets' precision, or saying other
+// than the renderer's choice: the CPU and 32f on a software renderer, the GPU and 16f on a GPU;
+// DEFOCUS_DEPTH_PREP overriding it.
+TEST_F(CliFlags, InfoSaysWhereDepthPrepRunsAndThePresetsPrecision)
+{
+    const Ran r = defocus("--info");
+    const bool software = r.out.find("GL renderer:  llvmpipe") != std::string::npos ||
+                          r.out.find("GL renderer:  softpipe") != std::string::npos;
+    EXPECT_NE(r.out.find(software ? "Depth prep:   CPU" : "Depth prep:   GPU"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(software ? "Precision:    32f" : "Precision:    16f"), std::string::npos) << r.out;
+    ::setenv("DEFOCUS_DEPTH_PREP", software ? "gpu" : "cpu", 1);
+    const Ran chosen = defocus("--info");
+    ::unsetenv("DEFOCUS_DEPTH_PREP");
+    EXPECT_NE(chosen.out.find(software ? "Depth prep:   GPU" : "Depth prep:   CPU"), std::string::npos) << chosen.out;
+}
+
 // Defects: -q printing the log, -v not adding the debug lines, --version not the version.
 TEST_F(CliFlags, QuietVerboseAndVersion)
 {

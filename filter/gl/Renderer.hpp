@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// What kind of renderer a GL_RENDERER string names: the choices that depend on it (where depth
-// prep runs, the presets' precision) are made from this one test.
+// What kind of renderer a GL_RENDERER string names, and the choices made from it: where depth
+// prep runs and the presets' precision (TargetFormat::Auto), so that the pipeline, the bench and
+// `defocus --info` say the same.
 #pragma once
 
 #include <string_view>
@@ -9,10 +10,19 @@ namespace defocus::gl {
 
 /// Mesa's software renderers (llvmpipe, softpipe, the classic swrast), which run the GPU's work
 /// on the CPU.
-inline bool isSoftwareRenderer(std::string_view glRenderer)
+bool isSoftwareRenderer(std::string_view glRenderer);
+
+/// Depth prep and the scene measurement on the GPU on this renderer, unless told otherwise:
+/// DEFOCUS_DEPTH_PREP=gpu or cpu chooses on any renderer (tests and profiling; another value is
+/// warned about and ignored); otherwise the GPU, but the CPU on a software renderer, where it is
+/// faster (docs/benchmarks.md).
+bool depthPrepOnGpu(std::string_view glRenderer);
+
+/// The presets' precision on this renderer: half-float targets on a GPU, full float on a software
+/// renderer, which converts half floats on every fetch and store.
+inline bool halfFloatTargets(std::string_view glRenderer)
 {
-    return glRenderer.starts_with("llvmpipe") || glRenderer.starts_with("softpipe") ||
-           glRenderer.find("Software Rasterizer") != std::string_view::npos;
+    return !isSoftwareRenderer(glRenderer);
 }
 
 } // namespace defocus::gl

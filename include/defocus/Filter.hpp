@@ -142,6 +142,13 @@ struct RendererInfo {
     std::string glRenderer;  ///< GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
     std::string glVersion;   ///< GL_VERSION
     bool timerQueries = false; ///< the driver has GPU timer queries (Timings::gpu is filled)
+    /// Depth preparation and the scene measurement run on the GPU (the frame's depth goes up as
+    /// it came); on a software renderer (llvmpipe) the CPU does them, which is faster there.
+    /// DEFOCUS_DEPTH_PREP=gpu or cpu chooses on any renderer.
+    bool depthPrepOnGpu = false;
+    /// The presets' render targets are half float (Quality::precision left to the renderer):
+    /// on a GPU; full float on a software renderer.
+    bool halfFloatTargets = false;
 };
 
 /// The EGL display (an initialised EGLDisplay) a Filter with a context of its own renders on
