@@ -126,11 +126,7 @@ double validDepthRange(const cv::Mat& depth, float& lo, float& hi)
     return depth.empty() ? 1.0 : static_cast<double>(invalid) / static_cast<double>(depth.total());
 }
 
-/// GL_RENDERER of the current context. On llvmpipe, depth prep and the scene measurement cost
-/// more on its GPU than on the CPU: 8.7 and 34 ms a 640x480 frame against 1.5 and 1.3 (each
-/// pass's wall time, `defocus-bench --sizes 640x480 --versus-cpu-prep --finish-each-pass`), its
-/// fragment shaders paying 15 ns a pixel and its compute shaders' barriers more
-/// (gl::depthPrepOnGpu()).
+/// GL_RENDERER of the current context, for the choices made from it (filter/gl/Renderer.hpp).
 std::string_view rendererName()
 {
     const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
@@ -169,6 +165,7 @@ struct FrameContext {
     gl::Texture colorBytes;   ///< 8-bit frames: colorTexture's bytes, undecoded (SceneMeasurePass)
     gl::Texture depthAsGiven; ///< the frame's depth as it came (prepareOnGpu)
     gl::Texture depth;        ///< filled, the frame's size
+    gl::Framebuffer depthTarget; ///< `depth`'s (DepthPrepPass writes it)
     gl::StorageBuffer measurementBuffer; ///< SceneMeasurePass's, until read
     bool measuring = false;   ///< the GPU's measurement is submitted and not yet read
     bool hasDepth = false;    ///< the frame came with depth (the GPU's measurement counts its holes)
@@ -229,7 +226,7 @@ struct Pipeline::Impl {
     /// Frames begin() took that finish() has not, oldest first.
     std::deque<FrameContext> staged;
     /// Contexts of frames done with, for the next begin() to reuse their textures and buffers.
-    std::vector<FrameContext> spare;
+    std::vector<FrameContext> spareContexts;
     cv::Size size;     ///< current's
     cv::Size blurSize; ///< the blur passes': the frame's, or half or a quarter of it (Resolution::Half)
     int blurShift = 0; ///< log2 of size / blurSize (the plan's FramePlan::blurShift)
@@ -280,12 +277,19 @@ struct Pipeline::Impl {
             rhombiSecondPass(nullptr);
     }
     void uploadNearDiameter();
+    /// `f`'s filled depth texture (and its framebuffer) of the frame's size.
+    static void ensureDepth(FrameContext& f)
+    {
+        if (ensureTexture(f.depth, GL_R32F, f.size, "filled depth"))
+            f.depthTarget = gl::Framebuffer(f.depth, "filled depth");
+    }
     /// `f`'s colour into its colorTexture (and its bytes' view), through `ring` or straight.
     static void uploadColor(FrameContext& f, gl::UploadRing* ring)
     {
         const bool srgbInput = f.color.depth() == CV_8U;
         if (ensureTexture(f.colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, f.size, "input colour"))
-            f.colorBytes = srgbInput ? gl::Texture::view(f.colorTexture, GL_RGB8, "input colour, bytes") : gl::Texture();
+            f.colorBytes =
+                srgbInput ? gl::Texture::view(f.colorTexture, GL_RGB8, "input colour, bytes") : gl::Texture();
         // BGRx goes up as it is: the texture has no alpha, so the fourth byte is dropped on the way.
         const GLenum format = f.color.channels() == 4 ? GL_BGRA : GL_BGR;
         const GLenum type = srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT;
@@ -378,9 +382,9 @@ void Pipeline::begin(const Frame& frame, const LensSettings& lens, const Quality
     CV_Assert(!frame.color.empty() &&
               (frame.color.type() == CV_8UC3 || frame.color.type() == CV_8UC4 || frame.color.type() == CV_32FC3));
     FrameContext f;
-    if (!p.spare.empty()) {
-        f = std::move(p.spare.back());
-        p.spare.pop_back();
+    if (!p.spareContexts.empty()) {
+        f = std::move(p.spareContexts.back());
+        p.spareContexts.pop_back();
     }
     p.begin(f, frame, lens, quality);
     f.beginMs = msSince(f.frameStart);
@@ -396,7 +400,7 @@ void Pipeline::dropBegun()
 {
     Impl& p = *impl_;
     for (FrameContext& f : p.staged)
-        p.spare.push_back(std::move(f));
+        p.spareContexts.push_back(std::move(f));
     p.staged.clear();
 }
 
@@ -452,7 +456,7 @@ void Pipeline::finish()
 {
     Impl& p = *impl_;
     CV_Assert(!p.staged.empty());
-    p.spare.push_back(std::exchange(p.current, std::move(p.staged.front())));
+    p.spareContexts.push_back(std::exchange(p.current, std::move(p.staged.front())));
     p.staged.pop_front();
     FrameContext& f = p.current;
     f.finishStart = Clock::now();
@@ -489,7 +493,7 @@ void Pipeline::Impl::prepare(FrameContext& f)
         // frame is planned (planFrame()), by when the GPU has long made it when a frame is in
         // flight before it.
         uploadColor(f, &uploads);
-        ensureTexture(f.depth, GL_R32F, f.size, "filled depth");
+        ensureDepth(f);
         f.hasDepth = !f.depthInput.empty();
         const cv::Mat given = f.depthInput.isContinuous() ? f.depthInput : f.depthInput.clone();
         if (f.hasDepth) {
@@ -501,7 +505,7 @@ void Pipeline::Impl::prepare(FrameContext& f)
         glBindVertexArray(vao.id());
         timer.begin(DepthPrepPass::kName);
         depthPrepPass.run(f.hasDepth ? &f.depthAsGiven : nullptr, f.fallbackDepth,
-                          lightEdges ? &f.colorTexture : nullptr, f.depth);
+                          lightEdges ? &f.colorTexture : nullptr, f.depth, f.depthTarget);
         timer.end();
         timer.begin(SceneMeasurePass::kName);
         sceneMeasurePass.run(f.depth, srgbInput ? f.colorBytes : f.colorTexture, srgbInput, f.coefficients,
@@ -518,7 +522,7 @@ void Pipeline::Impl::prepare(FrameContext& f)
         f.preparedOnCpu = true;
 
         start = Clock::now();
-        ensureTexture(f.depth, GL_R32F, f.size, "filled depth");
+        ensureDepth(f);
         // Straight: on a software renderer a ring's copy would come on top of the driver's own.
         uploadColor(f, nullptr);
         CV_Assert(f.prepared.metres.isContinuous());
@@ -548,28 +552,28 @@ void Pipeline::Impl::planFrame()
     f.nearestDepth = static_cast<float>(lo);
     f.farthestDepth = static_cast<float>(hi);
     analysis = finishAnalysis(f.measurement, f.coefficients, f.invalidFraction);
-    const bool allInFocus = plan.allInFocus && current.quality.adaptive;
+    const bool allInFocus = plan.allInFocus && f.quality.adaptive;
     // Highlights to treat: the plan's (FramePlan::highlights) on a frame not all in focus, which
     // makePlan() derives from the analysis alone, whatever size it picks.
     const bool lights = analysis.hasHighlights() && !analysis.allInFocus();
-    const bool eightBit = current.color.depth() == CV_8U;
-    const double highlightGain = eightBit && lights ? current.quality.highlightGain : 1.0;
+    const bool eightBit = f.color.depth() == CV_8U;
+    const double highlightGain = eightBit && lights ? f.quality.highlightGain : 1.0;
     // Sprites where a blurred pixel can be brighter than white: float input's highlights, or
     // 8-bit ones scaled up by the gain; and only where such pixels are few, lights rather than
     // bright surfaces (HighlightSpritePass::kMostHighlightPixels).
-    const bool sprites = current.quality.highlightSprites && current.quality.kernel == HexagonKernel::RhombiSum && lights &&
+    const bool sprites = f.quality.highlightSprites && f.quality.kernel == HexagonKernel::RhombiSum && lights &&
                          (!eightBit || highlightGain > 1.0) &&
                          analysis.highlightFraction <= HighlightSpritePass::kMostHighlightPixels;
     // Quarter size only on frames without bokeh sprites: the rims of the lights' hexagons, which
     // the gather draws up to white, came out 4 px soft at quarter size (the corpus enlarged 3x,
     // `defocus-bench accuracy --scale 3`: 0.38 dB less in the median, most of it in the lights'
     // zone; docs/benchmarks.md).
-    plan = makePlan(analysis, current.quality.nearField, current.quality.kernel, current.quality.resolution, current.quality.samples,
-                    current.quality.quarterOnLargeBlur && !sprites);
+    plan = makePlan(analysis, f.quality.nearField, f.quality.kernel, f.quality.resolution, f.quality.samples,
+                    f.quality.quarterOnLargeBlur && !sprites);
     setBlurShift(plan.blurShift);
     plan.highlightGain = highlightGain;
     plan.highlightSprites = sprites;
-    plan.gatherScale = current.gatherScale;
+    plan.gatherScale = f.gatherScale;
     plan.allInFocus = plan.allInFocus || allInFocus;
 }
 
@@ -599,7 +603,8 @@ void Pipeline::Impl::renderMcIntosh(bool useTiles)
     const float first = RhombusBlurPass::directions(current.bladeRotationDeg).u1;
     const auto blur = [&](const char* name, const gl::Texture& source, float angle, const Target& target) {
         timer.begin(name);
-        hexBlurPass.run(source, current.depth, angle, current.quality.samples, target.framebuffer, useTiles ? &blurTiles : nullptr);
+        hexBlurPass.run(source, current.depth, angle, current.quality.samples, target.framebuffer,
+                        useTiles ? &blurTiles : nullptr);
         if (useTiles)
             copyPass.run(source, copyTiles, target.framebuffer);
         timer.end();
@@ -615,7 +620,8 @@ void Pipeline::Impl::renderMcIntosh(bool useTiles)
         uploadNearDiameter();
         nearTiles.set(plan.nearTiles, blurSize, tileSize());
         timer.begin("near-field");
-        nearBlurPass.run(coc.texture, nearDiameter, first, current.quality.samples, true, nearHorizontal.framebuffer, nearTiles);
+        nearBlurPass.run(coc.texture, nearDiameter, first, current.quality.samples, true, nearHorizontal.framebuffer,
+                         nearTiles);
         nearBlurPass.run(nearHorizontal.texture, nearDiameter, first + 120.0f, current.quality.samples, false,
                          nearA.framebuffer, nearTiles);
         nearBlurPass.run(nearHorizontal.texture, nearDiameter, first - 120.0f, current.quality.samples, false,
@@ -641,8 +647,8 @@ void Pipeline::Impl::renderRhombi(bool useTiles)
     }
     const TileList* tiles = useTiles ? &blurTiles : nullptr;
     timer.begin("rhombi-1");
-    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, current.directions, current.quality.samples, tileSize(), tiles,
-                        false, plan.unrolledTaps);
+    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, current.directions, current.quality.samples,
+                        tileSize(), tiles, false, plan.unrolledTaps);
     if (useTiles)
         copyPass.run(coc.texture, copyTiles, first, true);
     timer.end();
@@ -682,8 +688,8 @@ void Pipeline::Impl::upscale(const gl::Framebuffer& out)
     }
     sharpened.ensure(coc.texture.format(), blurSize, "half-size result, sharpened");
     added.ensure(coc.texture.format(), blurSize, "half-size result minus input");
-    const UpscalePass::Io io{current.colorTexture,     current.depth,         coc.texture,
-                             blurred.texture,  sharpened.texture, added.texture,
+    const UpscalePass::Io io{current.colorTexture, current.depth,     coc.texture,
+                             blurred.texture,      sharpened.texture, added.texture,
                              prefiltered.of(sharpened, added, "upscale prefilter"), out};
     timer.begin(UpscalePass::kPrefilterName);
     upscalePass.prefilter(io);
@@ -727,8 +733,9 @@ void Pipeline::Impl::render()
         if (neighbourhoods.size() != bytes)
             neighbourhoods = gl::StorageBuffer(bytes, "tile neighbourhoods");
         neighbourhoods.update(analysis.tileNeighbourhood.data, bytes);
-        highlightSpritePass.find(current.colorTexture, current.depth, current.coefficients, static_cast<float>(plan.highlightGain),
-                                 CocPass::largestColor(half), current.aperture, plan.nearField,
+        highlightSpritePass.find(current.colorTexture, current.depth, current.coefficients,
+                                 static_cast<float>(plan.highlightGain), CocPass::largestColor(half), current.aperture,
+                                 plan.nearField,
                                  neighbourhoods, analysis.highlightTiles,
                                  HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
                                                              analysis.highlightPixels));
@@ -738,8 +745,8 @@ void Pipeline::Impl::render()
         highlightTiles.set(analysis.highlightTiles, blurSize, tileSize());
     if (plan.highlightSprites)
         frameHighlightTiles.set(analysis.highlightTiles, size, SceneAnalysis::kTileSize);
-    cocPass.run(current.colorTexture, current.depth, current.coefficients, half, coc.framebuffer, static_cast<float>(plan.highlightGain),
-                blurShift, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
+    cocPass.run(current.colorTexture, current.depth, current.coefficients, half, coc.framebuffer,
+                static_cast<float>(plan.highlightGain), blurShift, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
                 &neighbourhoods, &highlightSpritePass.sprites(), &highlightTiles);
     timer.end();
     rhombiSecondPending = false;
@@ -800,7 +807,8 @@ Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, f
         // quarter size).
         p.timer.begin(InFocusLightPass::kName);
         const bool half = p.current.quality.targetFormat == TargetFormat::Rgba16F;
-        p.inFocusLightPass.run({p.current.colorTexture, p.current.depth, p.coc.texture, p.plan.nearField ? &p.nearDiameter : nullptr},
+        p.inFocusLightPass.run({p.current.colorTexture, p.current.depth, p.coc.texture,
+                                p.plan.nearField ? &p.nearDiameter : nullptr},
                                CocPass::uniforms(p.current.coefficients, half, static_cast<float>(p.plan.highlightGain),
                                                  HighlightSpritePass::kThreshold),
                                p.current.directions, p.current.quality.samples, p.tileSize(),
@@ -913,9 +921,8 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
         // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
         // CoC pass's clean-up (no NaN, no negatives, within the target's range).
         const bool srgbInput = p.current.color.depth() == CV_8U;
-        const cv::Mat linear = srgbInput ? cv::Mat()
-                                         : sanitizeLinear(p.current.color, CocPass::largestColor(
-                                                                        p.current.quality.targetFormat == TargetFormat::Rgba16F));
+        const bool half = p.current.quality.targetFormat == TargetFormat::Rgba16F;
+        const cv::Mat linear = srgbInput ? cv::Mat() : sanitizeLinear(p.current.color, CocPass::largestColor(half));
         read.ready = passThrough(p.current.color, linear, encoding);
         p.current.timings.readbackMs = msSince(start);
         p.current.timings.totalMs = p.current.spentMs();
@@ -1006,8 +1013,9 @@ const cv::Mat& Pipeline::filledDepth()
     if (!p.current.preparedOnCpu) {
         p.current.prepared.metres.create(p.size, CV_32FC1);
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
-        glGetTextureImage(p.current.depth.id(), 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(p.current.prepared.metres.total() * 4),
-                          p.current.prepared.metres.data);
+        cv::Mat& metres = p.current.prepared.metres;
+        glGetTextureImage(p.current.depth.id(), 0, GL_RED, GL_FLOAT, static_cast<GLsizei>(metres.total() * 4),
+                          metres.data);
         p.current.prepared.invalidFraction = p.current.invalidFraction;
         p.current.preparedOnCpu = true;
     }

@@ -29,7 +29,7 @@ layout(location = 0) out vec2 outLevel;
 layout(location = 0) out float outDepth;
 #endif
 
-uniform ivec2 uSize; // the target's
+layout(location = 0) uniform ivec2 uSize; // the target's (DepthPrepPass::kSizeLocation)
 
 // prepareDepth(): depths at or below kMinValidDepthM (1e-4 m), NaN and +-Inf are no measurement.
 bool isValidDepth(float z)
@@ -110,7 +110,7 @@ void main()
 layout(binding = 0) uniform sampler2D uLevel0;   // r: depth, g: 1 measured, 0 a hole
 layout(binding = 1) uniform sampler2D uLevel1;   // r: filled
 layout(binding = 2) uniform sampler2D uCoarsest; // 1x1: g > 0 when the frame has any measurement
-uniform float uFallbackM; // the whole frame's depth when nothing in it was measured
+layout(location = 1) uniform float uFallbackM; // the whole frame's depth when nothing was measured
 
 void main()
 {

@@ -20,35 +20,35 @@ gl::Program program(const char* step, const char* name)
 DepthPrepPass::DepthPrepPass()
     : split_(program("SPLIT", "depth prep: split")), push_(program("PUSH", "depth prep: push")),
       pull_(program("PULL", "depth prep: pull")), fill_(program("FILL", "depth prep: fill")),
-      lightEdges_(program("LIGHT_EDGES", "depth prep: light edges")),
-      fallbackLocation_(fill_.uniform("uFallbackM")), nearest_(GL_NEAREST, "depth prep nearest")
+      lightEdges_(program("LIGHT_EDGES", "depth prep: light edges")), nearest_(GL_NEAREST, "depth prep nearest")
 {
 }
 
-void DepthPrepPass::draw(const gl::Program& program, const gl::Framebuffer& target, int width, int height)
+void DepthPrepPass::draw(const gl::Program& program, const gl::Framebuffer& target)
 {
     program.use();
-    glUniform2i(program.uniform("uSize"), width, height);
+    glUniform2i(kSizeLocation, target.width(), target.height());
     target.bindForDraw();
     drawFullscreenTriangle();
 }
 
 void DepthPrepPass::run(const gl::Texture* depth, float fallbackM, const gl::Texture* lightColor,
-                        const gl::Texture& filled)
+                        const gl::Texture& filledDepth, const gl::Framebuffer& filled)
 {
     const int width = filled.width(), height = filled.height();
-    if (lightColor && (!unlit_ || unlit_.width() != width || unlit_.height() != height))
+    if (lightColor && (!unlit_ || unlit_.width() != width || unlit_.height() != height)) {
         unlit_ = gl::Texture(GL_R32F, width, height, "filled depth, lights' edges unmoved");
-    // A framebuffer of the caller's texture, made each frame: the texture may be new.
-    const gl::Texture& target = lightColor ? unlit_ : filled;
-    const gl::Framebuffer targetFramebuffer(target, "filled depth");
+        unlitTarget_ = gl::Framebuffer(unlit_, "filled depth, lights' edges unmoved");
+    }
+    const gl::Framebuffer& target = lightColor ? unlitTarget_ : filled;
     for (GLuint unit = 0; unit < 3; ++unit)
         glBindSampler(unit, nearest_.id());
     if (!depth) {
-        glClearTexImage(target.id(), 0, GL_RED, GL_FLOAT, &fallbackM);
+        glClearTexImage((lightColor ? unlit_ : filledDepth).id(), 0, GL_RED, GL_FLOAT, &fallbackM);
     } else {
         // The pyramid: the frame's size, then halves rounded up down to 1x1, at least one level
-        // below the frame (FILL reads it).
+        // below the frame (FILL reads it). Level 0 and the coarsest have no filled texture:
+        // FILL writes the frame's, and the coarsest is its own.
         std::size_t count = 0;
         for (int w = width, h = height; count < 2 || w > 1 || h > 1; ++count) {
             if (count > 0) {
@@ -61,37 +61,42 @@ void DepthPrepPass::run(const gl::Texture* depth, float fallbackM, const gl::Tex
             if (!level.pyramid || level.pyramid.width() != w || level.pyramid.height() != h) {
                 level.pyramid = gl::Texture(GL_RG32F, w, h, "depth pyramid");
                 level.pyramidTarget = gl::Framebuffer(level.pyramid, "depth pyramid");
-                level.filled = gl::Texture(GL_R32F, w, h, "depth pyramid, filled");
-                level.filledTarget = gl::Framebuffer(level.filled, "depth pyramid, filled");
+                level.filled = {};
+                level.filledTarget = {};
             }
         }
-        const auto size = [&](std::size_t i) { return std::pair(levels_[i].pyramid.width(), levels_[i].pyramid.height()); };
+        for (std::size_t i = 1; i + 1 < count; ++i)
+            if (!levels_[i].filled) {
+                const int w = levels_[i].pyramid.width(), h = levels_[i].pyramid.height();
+                levels_[i].filled = gl::Texture(GL_R32F, w, h, "depth pyramid, filled");
+                levels_[i].filledTarget = gl::Framebuffer(levels_[i].filled, "depth pyramid, filled");
+            }
         glBindTextureUnit(0, depth->id());
-        draw(split_, levels_[0].pyramidTarget, width, height);
+        draw(split_, levels_[0].pyramidTarget);
         for (std::size_t i = 1; i < count; ++i) {
             glBindTextureUnit(0, levels_[i - 1].pyramid.id());
-            const auto [w, h] = size(i);
-            draw(push_, levels_[i].pyramidTarget, w, h);
+            draw(push_, levels_[i].pyramidTarget);
         }
         // The coarsest level is its own filled depth (its r); each finer one pulls from the next.
+        const auto filledOf = [&](std::size_t i) {
+            return i + 1 == count ? levels_[i].pyramid.id() : levels_[i].filled.id();
+        };
         for (std::size_t i = count - 2; i >= 1; --i) {
             glBindTextureUnit(0, levels_[i].pyramid.id());
-            glBindTextureUnit(1, i + 2 == count ? levels_[i + 1].pyramid.id() : levels_[i + 1].filled.id());
-            const auto [w, h] = size(i);
-            draw(pull_, levels_[i].filledTarget, w, h);
+            glBindTextureUnit(1, filledOf(i + 1));
+            draw(pull_, levels_[i].filledTarget);
         }
         glBindTextureUnit(0, levels_[0].pyramid.id());
-        glBindTextureUnit(1, count == 2 ? levels_[1].pyramid.id() : levels_[1].filled.id());
+        glBindTextureUnit(1, filledOf(1));
         glBindTextureUnit(2, levels_[count - 1].pyramid.id());
         fill_.use();
-        glUniform1f(fallbackLocation_, fallbackM);
-        draw(fill_, targetFramebuffer, width, height);
+        glUniform1f(kFallbackLocation, fallbackM);
+        draw(fill_, target);
     }
     if (lightColor) {
-        const gl::Framebuffer out(filled, "filled depth");
         glBindTextureUnit(0, lightColor->id());
         glBindTextureUnit(1, unlit_.id());
-        draw(lightEdges_, out, width, height);
+        draw(lightEdges_, filled);
     }
 }
 

@@ -18,12 +18,13 @@ public:
     static constexpr const char* kName = "depth-prep";
     DepthPrepPass();
 
-    /// Fills `filled` (R32F, the frame's size) from `depth` (R32F metres; nullptr: the frame has
-    /// no depth, and all of it sits at `fallbackM`, as when no pixel of `depth` is a
-    /// measurement). `lightColor`: a float frame's linear colour, whose pixels above white take
-    /// the depth of the brightest nearer pixel round them; nullptr: no such step. Needs a
-    /// vertex array bound (the full-screen triangle).
-    void run(const gl::Texture* depth, float fallbackM, const gl::Texture* lightColor, const gl::Texture& filled);
+    /// Fills `filledDepth` (R32F, the frame's size; `filled` its framebuffer) from `depth` (R32F
+    /// metres; nullptr: the frame has no depth, and all of it sits at `fallbackM`, as when no
+    /// pixel of `depth` is a measurement). `lightColor`: a float frame's linear colour, whose
+    /// pixels above white take the depth of the brightest nearer pixel round them; nullptr: no
+    /// such step. Needs a vertex array bound (the full-screen triangle).
+    void run(const gl::Texture* depth, float fallbackM, const gl::Texture* lightColor, const gl::Texture& filledDepth,
+             const gl::Framebuffer& filled);
     /// The frame's size, RG32F: g is 1 where the last run's depth had a measurement, 0 at its
     /// holes (SceneMeasurePass counts them). Empty until a run with depth.
     const gl::Texture& measured() const { return levels_.empty() ? none_ : levels_.front().pyramid; }
@@ -32,18 +33,21 @@ private:
     struct Level {
         gl::Texture pyramid;    ///< RG32F: depth, weight
         gl::Framebuffer pyramidTarget;
-        gl::Texture filled;     ///< R32F: its holes filled (PULL); unused at level 0 and the coarsest
+        gl::Texture filled;     ///< R32F: its holes filled (PULL); none at level 0 and the coarsest
         gl::Framebuffer filledTarget;
     };
-    /// Draws `program` into `target` of `width` x `height` pixels.
-    void draw(const gl::Program& program, const gl::Framebuffer& target, int width, int height);
+    /// depth_prep.frag's uniforms, at explicit locations.
+    static constexpr GLint kSizeLocation = 0;     ///< uSize: the target's
+    static constexpr GLint kFallbackLocation = 1; ///< uFallbackM (FILL)
+    /// Draws `program` over the whole of `target`.
+    static void draw(const gl::Program& program, const gl::Framebuffer& target);
 
     gl::Program split_, push_, pull_, fill_, lightEdges_;
-    GLint fallbackLocation_ = -1;
     gl::Sampler nearest_;
     /// Level 0 has the frame's size, each next one half the last (rounded up), down to 1x1.
     std::vector<Level> levels_;
     gl::Texture unlit_; ///< the filled depth before the light edges
+    gl::Framebuffer unlitTarget_;
     gl::Texture none_;
 };
 
