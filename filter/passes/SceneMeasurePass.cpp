@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "filter/ColorSpace.hpp"
@@ -25,7 +26,7 @@ struct Tile {
     std::uint32_t highlights;
     float luminance;
 };
-static_assert(sizeof(Header) == 48 && sizeof(Tile) == 16);
+static_assert(sizeof(Header) == 48 && sizeof(Tile) == 16 && sizeof(Header) % sizeof(Tile) == 0);
 
 cv::Size tilesOf(cv::Size frame)
 {
@@ -77,11 +78,12 @@ SceneMeasurement SceneMeasurePass::read(const gl::StorageBuffer& buffer, cv::Siz
                                         std::size_t& invalidPixels)
 {
     const cv::Size grid = tilesOf(frame);
+    // The header and the tiles in one read (one wait for the GPU), as the shader lays them out.
+    std::vector<Tile> words(sizeof(Header) / sizeof(Tile) + static_cast<std::size_t>(grid.area()));
+    buffer.read(words.data(), static_cast<GLsizeiptr>(sizeof(Header) + grid.area() * sizeof(Tile)));
     Header header{};
-    std::vector<Tile> tiles(static_cast<std::size_t>(grid.area()));
-    buffer.read(&header, sizeof header);
-    glGetNamedBufferSubData(buffer.id(), sizeof header, static_cast<GLsizeiptr>(tiles.size() * sizeof(Tile)),
-                            tiles.data());
+    std::memcpy(&header, words.data(), sizeof header);
+    const Tile* tiles = words.data() + sizeof(Header) / sizeof(Tile);
     invalidPixels = countedHoles ? header.invalidPixels : static_cast<std::size_t>(frame.area());
 
     SceneMeasurement m;
@@ -96,7 +98,7 @@ SceneMeasurement SceneMeasurePass::read(const gl::StorageBuffer& buffer, cv::Siz
     m.tileLuminance.create(grid, CV_32F);
     for (int ty = 0, i = 0; ty < grid.height; ++ty)
         for (int tx = 0; tx < grid.width; ++tx, ++i) {
-            const Tile& t = tiles[static_cast<std::size_t>(i)];
+            const Tile& t = tiles[i];
             m.tileMinDepth.at<float>(ty, tx) = t.minDepth;
             m.tileMaxDepth.at<float>(ty, tx) = t.maxDepth;
             m.tileHighlights.at<int>(ty, tx) = static_cast<int>(t.highlights);
