@@ -231,10 +231,13 @@ struct Filter::Impl {
     /// The frame process(), submit() and processTextures() filter from the caller's images, and its lens (the
     /// autofocus stepped); throws InputError and SettingsError as process() documents.
     Frame admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens);
-    /// admit() and the frame's passes on the pipeline (whose context must be current); the frame
-    /// and its lens kept for the report.
+    /// admit() and the frame begun on the pipeline (whose context must be current): uploaded and
+    /// measured; the frame and its lens kept for the report.
+    void beginFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
+    /// beginFrame() and the frame finished: planned and its passes run (no frame in flight).
     void processFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
-    /// submit() without its check: the frame's passes run, its read queued into inFlight.
+    /// submit() without its check: the frame begun, the one submitted before finished and its
+    /// read queued, the frame queued into inFlight.
     void submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
     /// receive() of a frame in flight (there must be one).
     cv::Mat receiveFrame();
@@ -483,23 +486,25 @@ std::vector<Timings::Pass> Filter::finishGpuTimings()
     return out;
 }
 
-void Filter::Impl::processFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+void Filter::Impl::beginFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
 {
-    LensSettings frameLens;
-    Frame frame = admit(color, depth, timestampS, frameLens);
-    pipeline->process(frame, frameLens, quality);
-    lastFrame = std::move(frame);
-    lastLens = frameLens;
-}
-
-void Filter::Impl::submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
-{
-    const auto bound = current();
     LensSettings frameLens;
     Frame frame = admit(color, depth, timestampS, frameLens);
     pipeline->begin(frame, frameLens, quality);
     lastFrame = std::move(frame);
     lastLens = frameLens;
+}
+
+void Filter::Impl::processFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+{
+    beginFrame(color, depth, timestampS);
+    pipeline->finish();
+}
+
+void Filter::Impl::submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+{
+    const auto bound = current();
+    beginFrame(color, depth, timestampS);
     // The frame submitted before goes on now, behind this one's upload and measurement: the GPU
     // runs its passes while the CPU plans it, and measures this one meanwhile.
     for (InFlight& entry : inFlight)
