@@ -21,12 +21,36 @@
 namespace defocus {
 namespace {
 
-Frame tumFrame()
+/// The first `count` frames of the bundled TUM clip.
+std::vector<Frame> tumFrames(std::size_t count)
 {
     auto source = openSource({test::dataDir() / "tum_fr1_rpy", std::nullopt, std::nullopt});
-    auto frame = source->next();
-    EXPECT_TRUE(frame && !frame->depth.empty());
-    return frame ? *frame : Frame{};
+    std::vector<Frame> frames;
+    while (frames.size() < count)
+        if (auto frame = source->next())
+            frames.push_back(*frame);
+        else
+            break;
+    EXPECT_EQ(frames.size(), count);
+    for (const Frame& frame : frames)
+        EXPECT_FALSE(frame.depth.empty()) << frame.name;
+    return frames;
+}
+
+Frame tumFrame()
+{
+    const std::vector<Frame> frames = tumFrames(1);
+    return frames.empty() ? Frame{} : frames.front();
+}
+
+/// The corpus' railing-lights scene: float colour with lights above white over depth edges.
+Frame railingLights()
+{
+    const auto dir = test::dataDir() / "corpus" / "railing-lights";
+    Frame frame;
+    frame.color = readColor(dir / "color_linear.exr");
+    frame.depth = readDepth(dir / "depth_mm.png", 1000.0);
+    return frame;
 }
 
 LensSettings tumLens()
@@ -134,10 +158,7 @@ TEST_F(DepthPrepGpu, GpuPutsAFrameWithoutMeasurementsAtTheFocusDistance)
 // the sprites' light and the gather's disagree with the CPU's.
 TEST_F(DepthPrepGpu, GpuPutsLightEdgesAtTheirLightsDepthAsTheCpuDoes)
 {
-    const auto dir = test::dataDir() / "corpus" / "railing-lights";
-    Frame frame;
-    frame.color = readColor(dir / "color_linear.exr");
-    frame.depth = readDepth(dir / "depth_mm.png", 1000.0);
+    const Frame frame = railingLights();
     // The CPU's own step, to know that this frame has edges to move.
     PreparedDepth filled = prepareDepth(frame.depth, frame.color.size(), 1.0f);
     ASSERT_GT(putLightEdgesAtTheirLightsDepth(frame.color, filled.metres), 50u);
@@ -159,10 +180,7 @@ TEST_F(DepthPrepGpu, GpuPutsLightEdgesAtTheirLightsDepthAsTheCpuDoes)
 TEST_F(DepthPrepGpu, GpuMeasuresTheSceneAsTheCpuDoes)
 {
     const Frame tum = tumFrame();
-    Frame lights;
-    const auto dir = test::dataDir() / "corpus" / "railing-lights";
-    lights.color = readColor(dir / "color_linear.exr");
-    lights.depth = readDepth(dir / "depth_mm.png", 1000.0);
+    const Frame lights = railingLights();
     SideBySide pipelines;
     for (const Frame* frame : std::initializer_list<const Frame*>{&tum, &lights}) {
         pipelines.run(*frame, tumLens(), presetSettings("balanced"));
@@ -175,9 +193,10 @@ TEST_F(DepthPrepGpu, GpuMeasuresTheSceneAsTheCpuDoes)
         EXPECT_EQ(a.histogram, b.histogram) << which;
         EXPECT_EQ(a.highlightPixels, b.highlightPixels) << which;
         EXPECT_EQ(a.highlightTiles, b.highlightTiles) << which;
-        if (!b.tileNeighbourhood.empty())
+        if (!b.tileNeighbourhood.empty()) {
             EXPECT_LE(cv::norm(a.tileNeighbourhood, b.tileNeighbourhood, cv::NORM_RELATIVE | cv::NORM_INF), 1e-5)
                 << which;
+        }
         const FramePlan& p = pipelines.gpu.plan();
         const FramePlan& q = pipelines.cpu.plan();
         EXPECT_EQ(p.blurTiles, q.blurTiles) << which;
@@ -215,11 +234,7 @@ TEST_P(DepthPrepOnGpu, FrameOutIsTheCpusOnTheTumClip)
 // give the bytes one frame at a time gives, with depth prep on the GPU and on the CPU.
 TEST_P(DepthPrepOnGpu, FramesBegunAheadGiveTheSerialFrames)
 {
-    auto source = openSource({test::dataDir() / "tum_fr1_rpy", std::nullopt, std::nullopt});
-    std::vector<Frame> frames;
-    while (auto frame = source->next())
-        if (frames.size() < 4)
-            frames.push_back(*frame);
+    std::vector<Frame> frames = tumFrames(4);
     ASSERT_EQ(frames.size(), 4u);
     frames[2].depth = cv::Mat(frames[2].depth.size(), CV_32F, cv::Scalar(1.0f)); // all in focus at 1 m
     const auto lensOf = [](std::size_t i) {
@@ -252,7 +267,7 @@ TEST_P(DepthPrepOnGpu, FramesBegunAheadGiveTheSerialFrames)
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, DepthPrepOnGpu, ::testing::ValuesIn(test::presetsAndKernels()),
-                         [](const auto& info) { return info.param.name; });
+                         [](const ::testing::TestParamInfo<test::NamedQuality>& p) { return p.param.name; });
 
 } // namespace
 } // namespace defocus
