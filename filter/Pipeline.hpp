@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// The depth-of-field pipeline, a frame at a time or one begun ahead: a frame whose valid depths all give less than half a
-// pixel of CoC is passed through before anything else; otherwise upload, depth hole filling and
-// the scene measurement (on the GPU, or on the CPU on a software renderer: prepareOnGpu()), the
-// analysis and the per-frame plan (which tiles blur, which are copied, whether
+// The depth-of-field pipeline, a frame at a time or one begun ahead: a frame whose valid depths
+// all give less than half a pixel of CoC is passed through before anything else; otherwise
+// upload, depth hole filling and the scene measurement (on the GPU, or on the CPU on a software
+// renderer: prepareOnGpu()), the analysis and the per-frame plan (which tiles blur, which are copied, whether
 // the near field, highlights and sprites run), the CoC pass, the blurs (QualitySettings::kernel:
 // two passes of one-sided lines summed into three rhombi, the default, or McIntosh et al.'s three
 // directional blurs and the min() of two), at full or half size (half: a prefilter and an upscale

@@ -219,7 +219,8 @@ void addQualityOptions(CLI::App& app, Quality& quality, QualityNames& names)
                    "How the blurs make the hexagon: rhombi (three one-sided rhombi summed, keeps highlight energy) "
                    "or mcintosh (McIntosh et al. 2012, min of two) [default: from --quality]")
         ->check(CLI::IsMember({"rhombi", "mcintosh"}));
-    app.add_option("--precision", names.precision, "Intermediate render targets: 16f or 32f [default: the renderer's, 16f on a GPU, 32f on llvmpipe]")
+    app.add_option("--precision", names.precision,
+                   "Intermediate render targets: 16f or 32f [default: the renderer's, 16f on a GPU, 32f on llvmpipe]")
         ->check(CLI::IsMember({"16f", "32f"}));
     app.add_option("--resolution", names.resolution,
                    "Size the blurs run at: full, or half (a quarter of the pixels; the output keeps the frame's "

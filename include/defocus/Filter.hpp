@@ -205,8 +205,9 @@ public:
     /// otherwise it throws InputError): the same result as process() of the same images, byte for
     /// byte, into `frame.output` (Settings::output is taken as Srgb8). Call it on the thread where
     /// that context is current. The colour and depth are read back (glGetTextureImage) and go
-    /// through depth preparation and the scene measurement as process()'s do; the output is rendered on the GPU, except frames all in
-    /// focus and the depth and coc views, which are uploaded. The call waits for no fence: the
+    /// through depth preparation and the scene measurement as process()'s do; the output is
+    /// rendered on the GPU, except frames all in focus and the depth and coc views, which are
+    /// uploaded. The call waits for no fence: the
     /// caller orders its own work around it (GStreamer: GstGLSyncMeta). GL state: it puts back the
     /// framebuffer bindings, viewport, program, vertex array, active texture, the 2D texture and
     /// sampler bindings of units 0-7, pixel-store alignment and row length, the pixel pack and
@@ -224,9 +225,10 @@ public:
     /// result, the bytes process() would have returned for it (planning it first if no submit()
     /// has), waiting for it, and makes lastFrame() that frame's report (its totalMs and
     /// readbackMs: the time spent on it in its submit(), the next and receive(), not the time
-    /// it waited between them); nullopt when none is in flight. With kFramesInFlight submitted before each receive(), the GPU measures a frame
-    /// and runs the passes of the one before while the CPU plans; the CPU's own work (upload,
-    /// or depth preparation on a software renderer) overlaps the GPU's. The images are
+    /// it waited between them); nullopt when none is in flight. With kFramesInFlight submitted
+    /// before each receive(), the GPU measures a frame and runs the passes of the one before
+    /// while the CPU plans; the CPU's own work (upload, or depth preparation on a software
+    /// renderer) overlaps the GPU's. The images are
     /// referenced until the frame is received: leave their pixels unchanged until then.
     /// Settings changed between submits apply from the next submit. While frames are in flight,
     /// process() and contactSheet() throw Error; reset() drops them. Not for a Filter on the
