@@ -10,6 +10,18 @@
 namespace defocus::gl {
 
 void deleteTexture(GLuint id) { glDeleteTextures(1, &id); }
+
+void waitAndDelete(GLsync& fence)
+{
+    if (fence == nullptr)
+        return;
+    // The first wait flushes; later ones wait a second at a time.
+    GLbitfield flags = GL_SYNC_FLUSH_COMMANDS_BIT;
+    while (glClientWaitSync(fence, flags, 1'000'000'000) == GL_TIMEOUT_EXPIRED)
+        flags = 0;
+    glDeleteSync(fence);
+    fence = nullptr;
+}
 void deleteFramebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
 void deleteBuffer(GLuint id) { glDeleteBuffers(1, &id); }
 void deleteVertexArray(GLuint id) { glDeleteVertexArrays(1, &id); }
@@ -204,13 +216,7 @@ void ReadbackBuffer::readPixels(GLuint framebuffer, int width, int height, GLenu
 void ReadbackBuffer::copyTo(void* data, GLsizeiptr bytes)
 {
     assert(bytes <= size_);
-    if (fence_ != nullptr) {
-        // The first wait flushes; later ones wait a second at a time.
-        GLbitfield flags = GL_SYNC_FLUSH_COMMANDS_BIT;
-        while (glClientWaitSync(fence_, flags, 1'000'000'000) == GL_TIMEOUT_EXPIRED)
-            flags = 0;
-        dropFence();
-    }
+    waitAndDelete(fence_);
     const void* mapped = glMapNamedBufferRange(handle_.id(), 0, bytes, GL_MAP_READ_BIT);
     if (mapped == nullptr)
         throw std::runtime_error("glMapNamedBufferRange failed on a readback buffer");

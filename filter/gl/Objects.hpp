@@ -60,6 +60,10 @@ void deleteSampler(GLuint id);
 void deleteQuery(GLuint id);
 void deleteProgram(GLuint id);
 
+/// Waits until the GPU has passed `fence` (flushing first, then a second at a time) and deletes
+/// it; nothing for a null fence.
+void waitAndDelete(GLsync& fence);
+
 /// Labels an object for GL debuggers and driver messages (no-op without GL_KHR_debug).
 void label(GLenum identifier, GLuint id, std::string_view name);
 

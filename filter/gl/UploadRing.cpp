@@ -16,23 +16,11 @@ UploadRing::~UploadRing()
             glDeleteSync(slot.fence);
 }
 
-void UploadRing::wait(Slot& slot)
-{
-    if (slot.fence == nullptr)
-        return;
-    // The first wait flushes; later ones wait a second at a time.
-    GLbitfield flags = GL_SYNC_FLUSH_COMMANDS_BIT;
-    while (glClientWaitSync(slot.fence, flags, 1'000'000'000) == GL_TIMEOUT_EXPIRED)
-        flags = 0;
-    glDeleteSync(slot.fence);
-    slot.fence = nullptr;
-}
-
 void UploadRing::upload(const Texture& texture, GLenum format, GLenum type, const void* data, std::size_t bytes)
 {
     Slot& slot = slots_[next_];
     next_ = (next_ + 1) % slots_.size();
-    wait(slot);
+    waitAndDelete(slot.fence); // the GPU has read the slot's last upload
     if (slot.size < bytes) {
         // Coherent: what the CPU writes is visible to the GPU's next command, with no flush.
         constexpr GLbitfield kFlags = GL_MAP_WRITE_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;

@@ -34,9 +34,6 @@ private:
         std::size_t size = 0;
         GLsync fence = nullptr; ///< the GPU's read of the slot's last upload
     };
-    /// Waits until the GPU has read `slot`'s last upload.
-    static void wait(Slot& slot);
-
     std::vector<Slot> slots_;
     std::size_t next_ = 0;
     std::string name_;
