@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// Pipeline: owns the targets, runs the passes in order, reads results back, times everything.
+// Pipeline: runs the frame graph's nodes on pooled targets, reads results back, times everything.
 #include "filter/Pipeline.hpp"
 
 #include <algorithm>
@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <string_view>
 #include <utility>
@@ -17,6 +18,7 @@
 #include "filter/Aperture.hpp"
 #include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
+#include "filter/FrameGraph.hpp"
 #include "filter/Lens.hpp"
 #include "filter/Views.hpp"
 #include "filter/gl/GpuTimer.hpp"
@@ -52,8 +54,8 @@ double msSince(Clock::time_point start)
 struct Target {
     gl::Texture texture;
     gl::Framebuffer framebuffer;
-    /// Counts the times the texture was (re)created: a framebuffer elsewhere that holds it
-    /// (the rhombus passes' pairs) must be remade when this moves.
+    /// Names the texture: a new number, unique in the process, each time it is (re)created, so
+    /// that a framebuffer or view made of it elsewhere knows when it must be remade.
     unsigned generation = 0;
 
     void ensure(GLenum format, cv::Size size, const char* name)
@@ -64,24 +66,63 @@ struct Target {
         framebuffer = {};
         texture = gl::Texture(format, size.width, size.height, name);
         framebuffer = gl::Framebuffer(texture, name);
-        ++generation;
+        static unsigned textures = 0;
+        generation = ++textures;
     }
 };
 
-/// A framebuffer with two targets' textures attached, remade whenever either texture is.
-struct TargetPair {
-    gl::Framebuffer framebuffer;
-    unsigned generations[2] = {0, 0};
-
-    const gl::Framebuffer& of(const Target& first, const Target& second, const char* name)
+/// The blur targets of the frame graph, keyed by format and size: a node's image takes a target
+/// of its key that the frame holds no other image in, or a new one. A frame gives its targets
+/// back when the next one is rendered; those the frame before did not take are deleted then (a
+/// new size, or the other kernel's images).
+class TargetPool {
+public:
+    Target& take(GLenum format, cv::Size size, std::string_view label)
     {
-        if (!framebuffer || generations[0] != first.generation || generations[1] != second.generation) {
-            framebuffer = gl::Framebuffer(first.texture, second.texture, name);
-            generations[0] = first.generation;
-            generations[1] = second.generation;
-        }
+        for (auto& entry : entries_)
+            if (!entry->held && entry->target.texture.format() == format &&
+                entry->target.texture.width() == size.width && entry->target.texture.height() == size.height) {
+                entry->held = true;
+                glObjectLabel(GL_TEXTURE, entry->target.texture.id(), static_cast<GLsizei>(label.size()), label.data());
+                return entry->target;
+            }
+        auto entry = std::make_unique<Entry>();
+        entry->target.ensure(format, size, std::string(label).c_str());
+        entry->held = true;
+        entries_.push_back(std::move(entry));
+        return entries_.back()->target;
+    }
+    /// A new frame: what the last one did not take goes; the rest is free again.
+    void nextFrame()
+    {
+        std::erase_if(entries_, [](const std::unique_ptr<Entry>& entry) { return !entry->held; });
+        for (auto& entry : entries_)
+            entry->held = false;
+        // A framebuffer of two targets lives as long as both do.
+        std::erase_if(pairs_, [this](const auto& pair) { return !holds(pair.first.first) || !holds(pair.first.second); });
+    }
+    /// A framebuffer with `first` and `second` attached (draw buffers 0 and 1), kept while both live.
+    const gl::Framebuffer& pair(const Target& first, const Target& second, std::string_view label)
+    {
+        gl::Framebuffer& framebuffer = pairs_[{first.generation, second.generation}];
+        if (!framebuffer)
+            framebuffer = gl::Framebuffer(first.texture, second.texture, label);
         return framebuffer;
     }
+    std::size_t size() const { return entries_.size(); }
+
+private:
+    struct Entry {
+        Target target;
+        bool held = false;
+    };
+    bool holds(unsigned generation) const
+    {
+        return std::any_of(entries_.begin(), entries_.end(),
+                           [&](const auto& entry) { return entry->target.generation == generation; });
+    }
+    std::vector<std::unique_ptr<Entry>> entries_; // stable addresses: nodes hold Target&
+    std::map<std::pair<unsigned, unsigned>, gl::Framebuffer> pairs_;
 };
 
 /// Makes `texture` anew unless it has `format` and `size`; true when it did.
@@ -211,14 +252,13 @@ struct Pipeline::Impl {
     bool upscaleUsesTiles = false;
     gl::GpuTimer timer;
 
-    Target coc, horizontal, diagonalA, diagonalB, outSrgb, outLinear;
-    // Rhombi: pass 1 writes X (horizontal) and Z (horizontalMean), pass 2 A and B (diagonalA/B).
-    Target horizontalMean;
-    TargetPair firstPair, secondPair;
-    Target nearHorizontal, nearA, nearB; ///< the foreground layer's blurs
-    Target blurred;   ///< Resolution::Half: the half-size result, upscaled into the output
-    Target sharpened, added; ///< Resolution::Half: the result prefiltered for the upscale
-    TargetPair prefiltered;
+    /// The blur targets (FrameGraph's pooled images), and the frame's own: which target each
+    /// image has (nullptr until a node writes it) and what the frame's nodes have written.
+    TargetPool pool;
+    std::array<Target*, kImageCount> images{};
+    std::vector<bool> written = std::vector<bool>(kImageCount, false);
+    Target outSrgb, outLinear;
+    float viewLow = 0.0f, viewHigh = 0.0f; ///< the last depth or CoC view's legend
     gl::Texture nearDiameter;            ///< per tile, R32F
 
     /// The frame the passes, the reads and the accessors are of: the one finish() took last.
@@ -254,28 +294,31 @@ struct Pipeline::Impl {
     SceneAnalysis analysis;
     FramePlan plan;
     bool rendered = false;
-    bool rhombiSecondPending = false; ///< rhombi: pass 2 of this frame has not written A and B
-    bool rhombiUsesTiles = false;
+    bool useTiles = false; ///< the blurs draw the plan's blur tiles and copy the rest
     std::size_t gpuFrameIndex = 0; ///< frame whose GPU scopes are pending in the timer
 
+    /// The frame's nodes (FrameGraph: frameNodes()), once a frame.
     void render();
-    /// `view` of the last frame rendered into the output target of `encoding` (not for a frame all
-    /// in focus): read() and readInto() without the read. `low`/`high`: the legend's range.
-    Target& renderOutput(View view, Encoding encoding, float& low, float& high);
+    /// `view` of the last frame rendered into `out` (not for a frame all in focus): the view's
+    /// nodes; `caller`: copied on into a caller's texture. read() and readInto() without the read.
+    void renderView(View view, const Target& out, const gl::Framebuffer* caller = nullptr, bool bgra = false);
+    /// The output target of `encoding`, of the frame's size.
+    Target& output(Encoding encoding);
+    /// The plan's choices, which pick the graph's nodes.
+    GraphChoices choices() const
+    {
+        return {current.quality.kernel, blurShift != 0, plan.nearField, plan.highlightSprites};
+    }
     /// The frame's read-back time from `readStart`, its total, and the GPU times it collected.
     void finishTimings(Clock::time_point readStart);
-    void renderMcIntosh(bool useTiles);
-    /// Rhombi: the CoC target's two lines (pass 1). Pass 2 waits for read(): the composite
-    /// runs fused into it, straight into the output; other views and readTarget() run it into
-    /// the A and B targets.
-    void renderRhombi(bool useTiles);
-    void rhombiSecondPass(const gl::Framebuffer* fusedTarget);
-    /// Pass 2 into A and B, if this frame's are not there yet.
-    void ensureDiagonals()
-    {
-        if (rhombiSecondPending)
-            rhombiSecondPass(nullptr);
-    }
+    /// Runs `node`; Image::Output is `out`, Image::CallerTexture `caller`.
+    void run(const Node& node, const Target* out, const gl::Framebuffer* caller, bool bgra);
+    /// The target of a pooled image, taken from the pool when a node first writes it this frame.
+    Target& image(Image which);
+    /// The framebuffer a node draws into: its one image's, or its two images' together.
+    const gl::Framebuffer& drawTarget(const Node& node, const Target* out);
+    /// The frame's texture of an image a node reads.
+    const gl::Texture& texture(Image which, const Target* out);
     void uploadNearDiameter();
     /// `f`'s filled depth texture (and its framebuffer) of the frame's size.
     static void ensureDepth(FrameContext& f)
@@ -313,31 +356,7 @@ struct Pipeline::Impl {
     }
     /// The analysis' tiles in the blur passes' pixels.
     int tileSize() const { return SceneAnalysis::kTileSize >> blurShift; }
-    /// Half size: the blurred result into `blurred`, then upscaled with the frame into `out`.
-    void upscale(const gl::Framebuffer& out);
-    /// The composite of A and B (and the McIntosh near layer) into `target`, unfused.
-    void composite(const gl::Framebuffer& target)
-    {
-        const bool near = plan.nearField;
-        if (current.quality.kernel == HexagonKernel::RhombiSum)
-            compositePass.runSum(diagonalA.texture, diagonalB.texture, target);
-        else
-            compositePass.run(diagonalA.texture, diagonalB.texture, target, near ? &nearA.texture : nullptr,
-                              near ? &nearB.texture : nullptr);
-    }
-
     explicit Impl(bool timers) : timer(timers) {}
-
-    const Target& target(View view) const
-    {
-        switch (view) {
-        case View::Input: return coc;
-        case View::Horizontal: return horizontal;
-        case View::DiagonalA: return diagonalA;
-        case View::DiagonalB: return diagonalB;
-        default: assert(false && "not an intermediate target"); return coc;
-        }
-    }
 };
 
 Pipeline::Pipeline(bool timers)
@@ -590,115 +609,142 @@ void Pipeline::Impl::uploadNearDiameter()
     }
 }
 
-void Pipeline::Impl::renderMcIntosh(bool useTiles)
+Target& Pipeline::Impl::image(Image which)
 {
-    const GLenum format = coc.texture.format();
-    horizontal.ensure(format, blurSize, "horizontal");
-    diagonalA.ensure(format, blurSize, "diagonal A");
-    diagonalB.ensure(format, blurSize, "diagonal B");
+    Target*& held = images[static_cast<std::size_t>(which)];
+    if (!held) {
+        assert(imageInfo(which).pooled);
+        held = &pool.take(current.quality.targetFormat == TargetFormat::Rgba16F ? GL_RGBA16F : GL_RGBA32F, blurSize,
+                          imageInfo(which).name);
+    }
+    return *held;
+}
+
+const gl::Texture& Pipeline::Impl::texture(Image which, const Target* out)
+{
+    switch (which) {
+    case Image::Color: return current.colorTexture;
+    case Image::Depth: return current.depth;
+    case Image::NearDiameter: return nearDiameter;
+    case Image::Output: return out->texture;
+    default: break;
+    }
+    assert(written[static_cast<std::size_t>(which)]);
+    return image(which).texture;
+}
+
+const gl::Framebuffer& Pipeline::Impl::drawTarget(const Node& node, const Target* out)
+{
+    const auto one = [&](Image which) -> const gl::Framebuffer& {
+        return which == Image::Output ? out->framebuffer : image(which).framebuffer;
+    };
+    if (node.writes.size() == 1)
+        return one(node.writes[0]);
+    assert(node.writes.size() == 2);
+    return pool.pair(image(node.writes[0]), image(node.writes[1]), node.name);
+}
+
+void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuffer* caller, bool bgra)
+{
+    const FrameContext& f = current;
+    const bool half = f.quality.targetFormat == TargetFormat::Rgba16F;
+    const int samples = f.quality.samples;
+    const gl::Texture* near = plan.nearField ? &nearDiameter : nullptr;
+    const TileList* tiles = useTiles ? &blurTiles : nullptr;
     // McIntosh et al.'s first pass runs along an edge of the hexagon. Edges and corners point
     // the same ways (mod 60 deg), so the edge nearest an axis is the rhombi's u1: with a corner
     // on top (rotation 0) the edges are vertical and the passes run at 90 and 90 +- 120 deg; with
     // a flat top (30) at 0 and +-120, as published.
-    const float first = RhombusBlurPass::directions(current.bladeRotationDeg).u1;
-    const auto blur = [&](const char* name, const gl::Texture& source, float angle, const Target& target) {
-        timer.begin(name);
-        hexBlurPass.run(source, current.depth, angle, current.quality.samples, target.framebuffer,
-                        useTiles ? &blurTiles : nullptr);
+    const float angle = RhombusBlurPass::directions(f.bladeRotationDeg).u1 + 120.0f * static_cast<float>(node.turn);
+    const auto input = [&](std::size_t i) -> const gl::Texture& { return texture(node.reads[i], out); };
+    timer.begin(node.name);
+    switch (node.pass) {
+    case PassKind::Coc:
+        // The bokeh sprites first: the CoC pass leaves their light out of the gather if they fit
+        // the frame's budget.
+        if (plan.highlightSprites)
+            highlightSpritePass.find(f.colorTexture, f.depth, f.coefficients, static_cast<float>(plan.highlightGain),
+                                     CocPass::largestColor(half), f.aperture, plan.nearField, neighbourhoods,
+                                     analysis.highlightTiles,
+                                     HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
+                                                                 analysis.highlightPixels));
+        cocPass.run(f.colorTexture, f.depth, f.coefficients, half, drawTarget(node, out),
+                    static_cast<float>(plan.highlightGain), blurShift,
+                    plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f, &neighbourhoods,
+                    &highlightSpritePass.sprites(), &highlightTiles);
+        break;
+    case PassKind::RhombiLines:
+    case PassKind::RhombiDiagonals:
+    case PassKind::RhombiComposite: {
+        const bool first = node.pass == PassKind::RhombiLines;
+        const bool fused = node.pass == PassKind::RhombiComposite;
+        const gl::Framebuffer& target = drawTarget(node, out);
+        rhombusBlurPass.run({input(0), first ? nullptr : &input(1), near, target}, first, f.directions, samples,
+                            tileSize(), tiles, fused, plan.unrolledTaps);
         if (useTiles)
-            copyPass.run(source, copyTiles, target.framebuffer);
-        timer.end();
-    };
-    blur("horizontal", coc.texture, first, horizontal);
-    blur("diagonal-a", horizontal.texture, first + 120.0f, diagonalA);
-    blur("diagonal-b", horizontal.texture, first - 120.0f, diagonalB);
-
-    if (plan.nearField) {
-        nearHorizontal.ensure(format, blurSize, "near horizontal");
-        nearA.ensure(format, blurSize, "near A");
-        nearB.ensure(format, blurSize, "near B");
-        uploadNearDiameter();
-        nearTiles.set(plan.nearTiles, blurSize, tileSize());
-        timer.begin("near-field");
-        nearBlurPass.run(coc.texture, nearDiameter, first, current.quality.samples, true, nearHorizontal.framebuffer,
-                         nearTiles);
-        nearBlurPass.run(nearHorizontal.texture, nearDiameter, first + 120.0f, current.quality.samples, false,
-                         nearA.framebuffer, nearTiles);
-        nearBlurPass.run(nearHorizontal.texture, nearDiameter, first - 120.0f, current.quality.samples, false,
-                         nearB.framebuffer, nearTiles);
-        timer.end();
+            copyPass.run(input(0), copyTiles, target, !fused);
+        break;
     }
-}
-
-void Pipeline::Impl::renderRhombi(bool useTiles)
-{
-    const GLenum format = coc.texture.format();
-    // The McIntosh passes share horizontal and the diagonals, and may have remade them since:
-    // the pairs follow the textures' generations, not this function's own calls.
-    horizontal.ensure(format, blurSize, "horizontal / rhombi X");
-    horizontalMean.ensure(format, blurSize, "rhombi Z");
-    diagonalA.ensure(format, blurSize, "diagonal A / rhombi A");
-    diagonalB.ensure(format, blurSize, "diagonal B / rhombi B");
-    const gl::Framebuffer& first = firstPair.of(horizontal, horizontalMean, "rhombi pass 1");
-    const gl::Texture* near = nullptr;
-    if (plan.nearField) {
-        uploadNearDiameter();
-        near = &nearDiameter;
+    case PassKind::McIntoshBlur: {
+        const gl::Framebuffer& target = drawTarget(node, out);
+        hexBlurPass.run(input(0), f.depth, angle, samples, target, tiles);
+        if (useTiles)
+            copyPass.run(input(0), copyTiles, target);
+        break;
     }
-    const TileList* tiles = useTiles ? &blurTiles : nullptr;
-    timer.begin("rhombi-1");
-    rhombusBlurPass.run({coc.texture, nullptr, near, first}, true, current.directions, current.quality.samples,
-                        tileSize(), tiles, false, plan.unrolledTaps);
-    if (useTiles)
-        copyPass.run(coc.texture, copyTiles, first, true);
-    timer.end();
-    rhombiSecondPending = true;
-    rhombiUsesTiles = useTiles;
-}
-
-void Pipeline::Impl::rhombiSecondPass(const gl::Framebuffer* fusedTarget)
-{
-    assert(rhombiSecondPending);
-    const gl::Texture* near = plan.nearField ? &nearDiameter : nullptr;
-    const TileList* tiles = rhombiUsesTiles ? &blurTiles : nullptr;
-    const gl::Framebuffer& target = fusedTarget ? *fusedTarget : secondPair.of(diagonalA, diagonalB, "rhombi pass 2");
-    glBindVertexArray(vao.id());
-    timer.begin("rhombi-2");
-    rhombusBlurPass.run({horizontal.texture, &horizontalMean.texture, near, target}, false,
-                        current.directions, current.quality.samples, tileSize(), tiles,
-                        fusedTarget != nullptr, plan.unrolledTaps);
-    if (rhombiUsesTiles)
-        copyPass.run(horizontal.texture, copyTiles, target, fusedTarget == nullptr);
-    timer.end();
-    if (!fusedTarget) {
-        rhombiSecondPending = false; // A and B hold this frame now
+    case PassKind::NearBlur:
+        nearBlurPass.run(input(0), nearDiameter, angle, samples, node.turn == 0, drawTarget(node, out), nearTiles);
+        break;
+    case PassKind::Composite:
+        if (f.quality.kernel == HexagonKernel::RhombiSum)
+            compositePass.runSum(input(0), input(1), drawTarget(node, out));
+        else
+            compositePass.run(input(0), input(1), drawTarget(node, out), plan.nearField ? &input(2) : nullptr,
+                              plan.nearField ? &input(3) : nullptr);
+        break;
+    case PassKind::Prefilter:
+    case PassKind::Upscale: {
+        const gl::Framebuffer& prefiltered = pool.pair(image(Image::Sharpened), image(Image::Added), "prefilter");
+        const UpscalePass::Io io{f.colorTexture, f.depth, texture(Image::Coc, out),
+                                 image(Image::Blurred).texture, image(Image::Sharpened).texture,
+                                 image(Image::Added).texture, prefiltered, out->framebuffer};
+        if (node.pass == PassKind::Prefilter)
+            upscalePass.prefilter(io);
+        else
+            upscalePass.upscale(io, f.coefficients, half, blurShift, upscaleUsesTiles ? &detailTiles : nullptr,
+                                plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f);
+        break;
     }
-}
-
-void Pipeline::Impl::upscale(const gl::Framebuffer& out)
-{
-    assert(blurShift != 0);
-    blurred.ensure(coc.texture.format(), blurSize, "half-size result");
-    if (rhombiSecondPending) {
-        rhombiSecondPass(&blurred.framebuffer);
-    } else {
-        timer.begin(CompositePass::kName);
-        composite(blurred.framebuffer);
-        timer.end();
+    case PassKind::HighlightSprites:
+        highlightSpritePass.draw(f.depth, out->framebuffer);
+        break;
+    case PassKind::InFocusLight:
+        inFocusLightPass.run({f.colorTexture, f.depth, texture(Image::Coc, out), near},
+                             CocPass::uniforms(f.coefficients, half, static_cast<float>(plan.highlightGain),
+                                               HighlightSpritePass::kThreshold),
+                             f.directions, samples, tileSize(), blurShift, frameHighlightTiles, out->framebuffer);
+        break;
+    case PassKind::ViewImage: {
+        if (node.view == View::Depth) {
+            viewLow = std::max(f.nearestDepth, 1e-3f);
+            viewHigh = std::max(f.farthestDepth, f.nearestDepth * 1.01f + 1e-3f);
+            viewPass.run(f.depth, ViewPass::Mode::Depth, viewLow, viewHigh, out->framebuffer);
+        } else if (node.view == View::Coc) {
+            // The lens' CoC in the target's pixels; the target holds the gather's.
+            viewHigh = f.maxCocPx / static_cast<float>(1 << blurShift);
+            viewPass.run(input(0), ViewPass::Mode::Coc, 0.0f, viewHigh * f.gatherScale, out->framebuffer);
+        } else {
+            viewPass.run(input(0), ViewPass::Mode::Color, 0.0f, 0.0f, out->framebuffer);
+        }
+        break;
     }
-    sharpened.ensure(coc.texture.format(), blurSize, "half-size result, sharpened");
-    added.ensure(coc.texture.format(), blurSize, "half-size result minus input");
-    const UpscalePass::Io io{current.colorTexture, current.depth,     coc.texture,
-                             blurred.texture,      sharpened.texture, added.texture,
-                             prefiltered.of(sharpened, added, "upscale prefilter"), out};
-    timer.begin(UpscalePass::kPrefilterName);
-    upscalePass.prefilter(io);
+    case PassKind::OutputCopy:
+        outputCopyPass.run(out->texture, out->generation, *caller, bgra);
+        break;
+    }
     timer.end();
-    timer.begin(UpscalePass::kName);
-    upscalePass.upscale(io, current.coefficients, current.quality.targetFormat == TargetFormat::Rgba16F, blurShift,
-                        upscaleUsesTiles ? &detailTiles : nullptr,
-                        plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f);
-    timer.end();
+    for (const Image image : node.writes)
+        written[static_cast<std::size_t>(image)] = true;
 }
 
 void Pipeline::Impl::render()
@@ -706,14 +752,15 @@ void Pipeline::Impl::render()
     if (!current.depthPrepared)
         planFrame(); // the all-in-focus exit, rendered for a view or readTarget()
     const auto start = Clock::now();
-    const bool half = current.quality.targetFormat == TargetFormat::Rgba16F;
-    coc.ensure(half ? GL_RGBA16F : GL_RGBA32F, blurSize, "coc");
+    pool.nextFrame();
+    images.fill(nullptr);
+    std::fill(written.begin(), written.end(), false);
 
     // Tiles in focus are copied, not blurred, when enough of them are: a thousand small quads
     // cost the rasteriser more than one full-screen triangle (on llvmpipe, drawing 1181 of 1200
     // tiles took 25 % longer than the whole frame), so a few copy tiles are not worth it.
-    const bool useTiles = current.quality.adaptive && !plan.copyTiles.empty() &&
-                          plan.copyTiles.size() * 4 >= plan.copyTiles.size() + plan.blurTiles.size();
+    useTiles = current.quality.adaptive && !plan.copyTiles.empty() &&
+               plan.copyTiles.size() * 4 >= plan.copyTiles.size() + plan.blurTiles.size();
     if (useTiles) {
         blurTiles.set(plan.blurTiles, blurSize, tileSize());
         copyTiles.set(plan.copyTiles, blurSize, tileSize());
@@ -723,100 +770,45 @@ void Pipeline::Impl::render()
                        plan.detailTiles.size() * 4 <= static_cast<std::size_t>(analysis.tiles.area()) * 3;
     if (upscaleUsesTiles)
         detailTiles.set(plan.detailTiles, size, SceneAnalysis::kTileSize);
-    glBindVertexArray(vao.id());
-    timer.begin(CocPass::kName);
-    // The bokeh sprites are found first (in the "coc" scope): the CoC pass leaves their light out
-    // of the gather if they fit the frame's budget.
+    if (plan.nearField) {
+        uploadNearDiameter();
+        if (current.quality.kernel == HexagonKernel::McIntoshMin)
+            nearTiles.set(plan.nearTiles, blurSize, tileSize());
+    }
     if (plan.highlightSprites) {
         CV_Assert(analysis.tileNeighbourhood.type() == CV_32FC4 && analysis.tileNeighbourhood.isContinuous());
         const auto bytes = static_cast<GLsizeiptr>(analysis.tileNeighbourhood.total() * sizeof(cv::Vec4f));
         if (neighbourhoods.size() != bytes)
             neighbourhoods = gl::StorageBuffer(bytes, "tile neighbourhoods");
         neighbourhoods.update(analysis.tileNeighbourhood.data, bytes);
-        highlightSpritePass.find(current.colorTexture, current.depth, current.coefficients,
-                                 static_cast<float>(plan.highlightGain), CocPass::largestColor(half), current.aperture,
-                                 plan.nearField,
-                                 neighbourhoods, analysis.highlightTiles,
-                                 HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
-                                                             analysis.highlightPixels));
     }
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
     if (plan.highlightSprites || plan.highlightGain > 1.0)
         highlightTiles.set(analysis.highlightTiles, blurSize, tileSize());
     if (plan.highlightSprites)
         frameHighlightTiles.set(analysis.highlightTiles, size, SceneAnalysis::kTileSize);
-    cocPass.run(current.colorTexture, current.depth, current.coefficients, half, coc.framebuffer,
-                static_cast<float>(plan.highlightGain), blurShift, plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f,
-                &neighbourhoods, &highlightSpritePass.sprites(), &highlightTiles);
-    timer.end();
-    rhombiSecondPending = false;
-    if (current.quality.kernel == HexagonKernel::RhombiSum)
-        renderRhombi(useTiles);
-    else
-        renderMcIntosh(useTiles);
+    glBindVertexArray(vao.id());
+    for (const Node& node : frameNodes(choices()))
+        run(node, nullptr, nullptr, false);
     current.timings.renderMs = msSince(start);
     rendered = true;
 }
 
-Target& Pipeline::Impl::renderOutput(View view, Encoding encoding, float& low, float& high)
+Target& Pipeline::Impl::output(Encoding encoding)
 {
-    Impl& p = *this;
-    if (!p.rendered)
-        p.render();
     const bool srgb = encoding != Encoding::Linear32F;
-    Target& out = srgb ? p.outSrgb : p.outLinear;
-    out.ensure(srgb ? GL_SRGB8_ALPHA8 : GL_RGBA32F, p.size, srgb ? "output sRGB" : "output linear");
-
-    glBindVertexArray(p.vao.id());
-    const bool fused = view == View::Composite && (p.rhombiSecondPending || p.blurShift != 0);
-    if (fused) {
-        // Rhombi: pass 2 with the composite in it, into the output (no A and B targets); its
-        // timer scope is "rhombi-2", and no "composite" runs. At half size, the result goes to
-        // the half-size target and the upscale makes the output.
-        if (p.blurShift != 0)
-            p.upscale(out.framebuffer);
-        else
-            p.rhombiSecondPass(&out.framebuffer);
-    } else if (view == View::Composite) {
-        p.timer.begin(CompositePass::kName);
-        p.composite(out.framebuffer);
-    } else {
-        if (view == View::DiagonalA || view == View::DiagonalB)
-            p.ensureDiagonals();
-        p.timer.begin(ViewPass::kName);
-        if (view == View::Depth) {
-            const float lo = p.current.nearestDepth, hi = p.current.farthestDepth;
-            low = std::max(lo, 1e-3f);
-            high = std::max(hi, lo * 1.01f + 1e-3f);
-            p.viewPass.run(p.current.depth, ViewPass::Mode::Depth, low, high, out.framebuffer);
-        } else if (view == View::Coc) {
-            // The lens' CoC in the target's pixels; the target holds the gather's.
-            high = p.current.maxCocPx / static_cast<float>(1 << p.blurShift);
-            p.viewPass.run(p.coc.texture, ViewPass::Mode::Coc, 0.0f, high * p.current.gatherScale, out.framebuffer);
-        } else {
-            p.viewPass.run(p.target(view).texture, ViewPass::Mode::Color, 0.0f, 0.0f, out.framebuffer);
-        }
-    }
-    if (!fused)
-        p.timer.end();
-    if (view == View::Composite && p.plan.highlightSprites) {
-        p.timer.begin(HighlightSpritePass::kName);
-        p.highlightSpritePass.draw(p.current.depth, out.framebuffer);
-        p.timer.end();
-        // The light the CoC pass held back from pixels in focus goes back (sprites never run at
-        // quarter size).
-        p.timer.begin(InFocusLightPass::kName);
-        const bool half = p.current.quality.targetFormat == TargetFormat::Rgba16F;
-        p.inFocusLightPass.run({p.current.colorTexture, p.current.depth, p.coc.texture,
-                                p.plan.nearField ? &p.nearDiameter : nullptr},
-                               CocPass::uniforms(p.current.coefficients, half, static_cast<float>(p.plan.highlightGain),
-                                                 HighlightSpritePass::kThreshold),
-                               p.current.directions, p.current.quality.samples, p.tileSize(),
-                               p.blurShift, p.frameHighlightTiles, out.framebuffer);
-        p.timer.end();
-    }
-
+    Target& out = srgb ? outSrgb : outLinear;
+    out.ensure(srgb ? GL_SRGB8_ALPHA8 : GL_RGBA32F, size, srgb ? "output sRGB" : "output linear");
     return out;
+}
+
+void Pipeline::Impl::renderView(View view, const Target& out, const gl::Framebuffer* caller, bool bgra)
+{
+    if (!rendered)
+        render();
+    glBindVertexArray(vao.id());
+    for (const Node& node : viewNodes(choices(), view, written, caller != nullptr))
+        run(node, &out, caller, bgra);
 }
 
 void Pipeline::Impl::finishTimings(Clock::time_point readStart)
@@ -929,7 +921,10 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
         read.timings = p.current.timings;
         return pending;
     }
-    const Target& out = p.renderOutput(view, encoding, read.low, read.high);
+    const Target& out = p.output(encoding);
+    p.renderView(view, out);
+    read.low = p.viewLow;
+    read.high = p.viewHigh;
     // Into a buffer of the pool behind a fence: the pixels travel while the caller goes on.
     const int type = imageType(encoding);
     read.buffer = p.takeReadbackBuffer(static_cast<GLsizeiptr>(p.size.area()) * CV_ELEM_SIZE(type));
@@ -975,12 +970,8 @@ void Pipeline::readInto(View view, unsigned texture, bool bgra)
         return;
     }
     const auto start = Clock::now();
-    float low = 0.0f, high = 0.0f;
-    const Target& out = p.renderOutput(view, Encoding::Srgb8, low, high);
     const gl::Framebuffer target(texture, p.size.width, p.size.height, "caller's output");
-    p.timer.begin(OutputCopyPass::kName);
-    p.outputCopyPass.run(out.texture, out.generation, target, bgra);
-    p.timer.end();
+    p.renderView(view, p.output(Encoding::Srgb8), &target, bgra);
     p.finishTimings(start);
 }
 
@@ -993,11 +984,17 @@ cv::Mat Pipeline::run(const Frame& frame, const LensSettings& lens, const Qualit
 
 cv::Mat Pipeline::readTarget(View view)
 {
-    if (!impl_->rendered)
-        impl_->render();
-    if (view == View::DiagonalA || view == View::DiagonalB)
-        impl_->ensureDiagonals();
-    const Target& target = impl_->target(view);
+    Impl& p = *impl_;
+    if (!p.rendered)
+        p.render();
+    // The view's nodes but the last, which would draw the view: what writes the target.
+    std::vector<Node> nodes = viewNodes(p.choices(), view, p.written);
+    CV_Assert(view != View::Composite && view != View::Depth && view != View::Coc && !nodes.empty());
+    nodes.pop_back();
+    glBindVertexArray(p.vao.id());
+    for (const Node& node : nodes)
+        p.run(node, nullptr, nullptr, false);
+    const Target& target = p.image(viewedImage(view));
     cv::Mat image(target.texture.height(), target.texture.width(), CV_32FC4);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, target.framebuffer.id());
     glPixelStorei(GL_PACK_ALIGNMENT, 1);

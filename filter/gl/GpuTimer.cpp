@@ -24,13 +24,13 @@ GpuTimer::GpuTimer(bool enabled) : enabled_(enabled)
     glDeleteQueries(1, &id);
 }
 
-void GpuTimer::begin(const std::string& name)
+void GpuTimer::begin(std::string_view name)
 {
     if (finish_) {
         glFinish();
         Set& set = sets_[current_];
         if (set.used == set.scopes.size())
-            set.scopes.push_back({name, Handle<deleteQuery>(0)});
+            set.scopes.push_back({std::string(name), Handle<deleteQuery>(0)});
         set.scopes[set.used].name = name;
         started_ = std::chrono::steady_clock::now();
         return;
@@ -41,7 +41,7 @@ void GpuTimer::begin(const std::string& name)
     if (set.used == set.scopes.size()) {
         GLuint id = 0;
         glCreateQueries(GL_TIME_ELAPSED, 1, &id);
-        set.scopes.push_back({name, Handle<deleteQuery>(id)});
+        set.scopes.push_back({std::string(name), Handle<deleteQuery>(id)});
     }
     if (!set.scopes[set.used].query) { // made by a finishEachScope frame
         GLuint id = 0;

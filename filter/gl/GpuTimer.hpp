@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -23,7 +24,7 @@ public:
     explicit GpuTimer(bool enabled = true);
 
     /// Starts timing the scope `name` (scopes do not nest).
-    void begin(const std::string& name);
+    void begin(std::string_view name);
     void end();
     /// Profiling: glFinish around every scope, wall-clock times instead of queries. Slows the
     /// frame (no overlap of CPU and GPU work), so for per-pass figures only.

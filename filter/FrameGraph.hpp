@@ -1,0 +1,130 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// The passes of a frame, declared before any of them runs: an ordered list of nodes, each with
+// its name (the GPU timer scope, the GL label, the rows of --timing), the images it reads and the
+// images it writes. The frame plan picks the list (the rhombi or McIntosh's blurs, full or half
+// size, the near field, the bokeh sprites); a view adds the nodes that make it from what the
+// frame's nodes wrote. Pipeline runs the nodes in order and takes each image a node writes from
+// a pool of targets keyed by format and size, so an image nobody's list names is never made.
+// The graph is data: tests hold it valid (every image a node reads is the frame's own or written
+// by an earlier node; on the composite, every image written is read) without a GL context.
+#pragma once
+
+#include <cstdint>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "defocus/Frame.hpp"
+#include "filter/Settings.hpp"
+
+namespace defocus {
+
+/// The images (and one buffer) the passes of a frame read and write.
+enum class Image : std::uint8_t {
+    Color,          ///< the frame's colour, linear (imported: uploaded before the graph runs)
+    Depth,          ///< the frame's filled depth (imported)
+    NearDiameter,   ///< the near field's diameter per tile (imported: uploaded from the analysis)
+    Coc,            ///< colour and signed CoC at the blur size (View::Input)
+    Sprites,        ///< the bokeh sprites found for the lights (a buffer)
+    Horizontal,     ///< McIntosh's first blur, or the rhombi's line X (View::Horizontal)
+    HorizontalMean, ///< the rhombi's line Z
+    DiagonalA,      ///< McIntosh's or the rhombi's diagonal A (View::DiagonalA)
+    DiagonalB,      ///< (View::DiagonalB)
+    NearHorizontal, ///< McIntosh's near field, its first blur
+    NearA,          ///< McIntosh's near field, diagonal A
+    NearB,          ///< McIntosh's near field, diagonal B
+    Blurred,        ///< half size: the blurred result before the upscale
+    Sharpened,      ///< half size: the result prefiltered for the upscale
+    Added,          ///< half size: the result minus the input, prefiltered
+    Output,         ///< the view's image at the frame's size: what a read returns
+    CallerTexture,  ///< readInto(): a caller's texture
+};
+inline constexpr int kImageCount = static_cast<int>(Image::CallerTexture) + 1;
+
+/// How big an image is.
+enum class ImageScale : std::uint8_t {
+    Frame, ///< the frame's pixels
+    Blur,  ///< the blur passes' pixels: the frame's, or half of them (FramePlan::blurShift)
+    Tiles, ///< one texel per analysis tile
+    None   ///< a buffer
+};
+
+struct ImageInfo {
+    std::string_view name; ///< the GL label of its target
+    ImageScale scale;
+    /// Made before the graph runs (the frame's uploads), not by a node.
+    bool imported;
+    /// A blur target of the pool, in the frame's work format (RGBA16F or RGBA32F).
+    bool pooled;
+};
+const ImageInfo& imageInfo(Image image);
+
+/// What a node runs; Pipeline has one way to run each.
+enum class PassKind : std::uint8_t {
+    Coc,              ///< the CoC pass, the bokeh sprites found first when the plan has them
+    RhombiLines,      ///< rhombi pass 1: the lines X and Z
+    RhombiDiagonals,  ///< rhombi pass 2 into A and B
+    RhombiComposite,  ///< rhombi pass 2 with the composite in it, into its one output
+    McIntoshBlur,     ///< one of McIntosh's directional blurs (Node::turn says which)
+    NearBlur,         ///< one of McIntosh's near-field blurs (Node::turn says which)
+    Composite,        ///< A and B (and McIntosh's near layer) combined
+    Prefilter,        ///< half size: the result prefiltered for the upscale
+    Upscale,          ///< half size: the result upscaled, the frame's detail put back
+    HighlightSprites, ///< the bokeh sprites drawn over the output
+    InFocusLight,     ///< the light held back from pixels in focus put back
+    ViewImage,        ///< a view of an image (colour, the CoC or the depth with its scale)
+    OutputCopy,       ///< the output copied into a caller's texture
+};
+
+/// One pass of the frame.
+struct Node {
+    PassKind pass;
+    /// The GPU timer scope and the row of --timing; unique within a frame's list.
+    std::string_view name;
+    std::vector<Image> reads;
+    std::vector<Image> writes;
+    /// McIntoshBlur and NearBlur: the direction, in thirds of a turn from the first (0, 1, -1).
+    int turn = 0;
+    /// ViewImage: the view it draws (the depth and the CoC with their scales, others as colour).
+    View view = View::Composite;
+};
+
+/// What the graph of a frame depends on: the plan's choices.
+struct GraphChoices {
+    HexagonKernel kernel = HexagonKernel::RhombiSum;
+    bool half = false;       ///< the blurs at half size, upscaled (FramePlan::blurShift != 0)
+    bool nearField = false;  ///< FramePlan::nearField
+    bool sprites = false;    ///< FramePlan::highlightSprites
+};
+
+/// The nodes every frame that is not all in focus runs, whatever is read: the CoC and the blurs
+/// as far as they go without knowing the view.
+std::vector<Node> frameNodes(const GraphChoices& choices);
+
+/// The nodes that make `view` into Image::Output after the frame's nodes and any views read
+/// before it: `written` holds what those wrote (indexed by Image), which the list reuses (the
+/// rhombi's A and B, once a view of them wrote them). `toCaller` ends the list with the copy
+/// into the caller's texture. View::Input, Horizontal, DiagonalA and DiagonalB read the blur
+/// targets the frame's nodes wrote; readTarget() runs the list up to (not including) its last
+/// node for them.
+std::vector<Node> viewNodes(const GraphChoices& choices, View view, const std::vector<bool>& written,
+                            bool toCaller = false);
+
+/// frameNodes() and then the composite's viewNodes(): what a frame read once as the composite
+/// runs, in order.
+std::vector<Node> compositeFrame(const GraphChoices& choices);
+
+/// The image a view shows (Coc for View::Input, the depth for View::Depth, Output for the
+/// composite).
+Image viewedImage(View view);
+
+/// Why `nodes` (a frame's list, imports first made) is not a valid frame: an image read before
+/// any node wrote it, a name given twice, or (`everyWriteRead`) an image written that no later
+/// node reads and that is not the output. Empty when valid.
+std::string graphError(const std::vector<Node>& nodes, bool everyWriteRead);
+
+/// "coc > rhombi-1 > rhombi-2 > ..." for logs and --explain.
+std::string describe(const std::vector<Node>& nodes);
+
+} // namespace defocus
