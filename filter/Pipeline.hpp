@@ -8,10 +8,12 @@
 // directional blurs and the min() of two), at full or half size (half: a prefilter and an upscale
 // that puts the frame's in-focus pixels back), bokeh sprites for lights above white in the
 // aperture's exact shape (any blade count, the circle, squeezed: filter/Aperture.hpp; the gather's
-// hexagon is squeezed as the aperture is and covers its area), and the view read back. Owns every
-// intermediate target and reallocates them only when size or format changes; each frame's own
-// textures and measurement live in a frame context, so that the next frame can be uploaded and
-// measured (begin()) before this one's passes run (finish()).
+// hexagon is squeezed as the aperture is and covers its area), and the view read back. The passes
+// are the nodes of the frame graph (filter/FrameGraph.hpp) that the plan picks, run in order;
+// their images come from a pool of targets keyed by format and size, kept from frame to frame,
+// so only what a node writes is made. Each frame's own textures and measurement live in a frame
+// context, so that the next frame can be uploaded and measured (begin()) before this one's passes
+// run (finish()).
 // Needs a current GL 4.5 context (gl::EglContext) for its whole life.
 #pragma once
 

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "filter/ColorSpace.hpp"
+#include "filter/FrameGraph.hpp"
 
 namespace defocus {
 
@@ -284,8 +285,9 @@ std::string FramePlan::explain(const SceneAnalysis& analysis) const
     const int total = analysis.tiles.area();
     std::string text = allInFocus ? fmt::format("all in focus (max |CoC| {:.2f} px): input passed through, no pass ran",
                                                 analysis.maxAbsCoc())
-                                  : fmt::format("coc, blur {} on {}/{} tiles (copy {}), composite; CoC {:+.1f}..{:+.1f} px",
-                                                kernel == HexagonKernel::RhombiSum ? "rhombi x2" : "mcintosh x3",
+                                  : fmt::format("{}; blur on {}/{} tiles (copy {}); CoC {:+.1f}..{:+.1f} px",
+                                                describe(compositeFrame({kernel, blurShift != 0, nearField,
+                                                                         highlightSprites})),
                                                 blurTiles.size(), total, copyTiles.size(),
                                                 analysis.minCoc / gatherScale, analysis.maxCoc / gatherScale);
     if (allInFocus)

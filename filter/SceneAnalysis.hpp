@@ -127,7 +127,8 @@ struct FramePlan {
     /// pipeline; explain() reports the lens' CoC.
     float gatherScale = 1.0f;
 
-    /// One line for --explain, e.g. "blur 812/1200 tiles, copy 388; hole fill on (24.1 % invalid)".
+    /// One line for --explain: the passes the composite runs (FrameGraph's names), then e.g. "blur on
+    /// 812/1200 tiles (copy 388); ...; hole fill on (24.1 % invalid)".
     std::string explain(const SceneAnalysis& analysis) const;
 };
 
