@@ -188,6 +188,9 @@ struct FrameContext {
     /// The gather's CoC: the lens', scaled so that the rhombi's hexagon covers the aperture's
     /// area (gatherScale(); 1 for the hexagon). The sprites draw the aperture itself.
     CocCoefficients coefficients;
+    /// The CoC parameters every pass of the frame binds: the lens' from begin() (the scene
+    /// measurement), the plan's highlight gain and threshold added by render().
+    CocParams cocParams{"frame coc params"};
     float maxCocPx = 0.0f;
     ApertureShape aperture;
     float bladeRotationDeg = 0.0f; ///< the gather's hexagon's
@@ -527,7 +530,8 @@ void Pipeline::Impl::prepare(FrameContext& f)
                           lightEdges ? &f.colorTexture : nullptr, f.depth, f.depthTarget);
         timer.end();
         timer.begin(SceneMeasurePass::kName);
-        sceneMeasurePass.run(f.depth, srgbInput ? f.colorBytes : f.colorTexture, srgbInput, f.coefficients,
+        f.cocParams.set(f.coefficients, f.quality.targetFormat == TargetFormat::Rgba16F);
+        sceneMeasurePass.run(f.depth, srgbInput ? f.colorBytes : f.colorTexture, srgbInput, f.cocParams,
                              f.hasDepth ? &depthPrepPass.measured() : nullptr, f.measurementBuffer);
         timer.end();
         f.timings.depthPrepMs = msSince(start);
@@ -647,7 +651,6 @@ const gl::Framebuffer& Pipeline::Impl::drawTarget(const Node& node, const Target
 void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuffer* caller, bool bgra)
 {
     const FrameContext& f = current;
-    const bool half = f.quality.targetFormat == TargetFormat::Rgba16F;
     const int samples = f.quality.samples;
     const gl::Texture* near = plan.nearField ? &nearDiameter : nullptr;
     const TileList* tiles = useTiles ? &blurTiles : nullptr;
@@ -663,14 +666,11 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
         // The bokeh sprites first: the CoC pass leaves their light out of the gather if they fit
         // the frame's budget.
         if (plan.highlightSprites)
-            highlightSpritePass.find(f.colorTexture, f.depth, f.coefficients, static_cast<float>(plan.highlightGain),
-                                     CocPass::largestColor(half), f.aperture, plan.nearField, neighbourhoods,
+            highlightSpritePass.find(f.colorTexture, f.depth, f.cocParams, f.aperture, plan.nearField, neighbourhoods,
                                      analysis.highlightTiles,
                                      HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
                                                                  analysis.highlightPixels));
-        cocPass.run(f.colorTexture, f.depth, f.coefficients, half, drawTarget(node, out),
-                    static_cast<float>(plan.highlightGain), blurShift,
-                    plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f, &neighbourhoods,
+        cocPass.run(f.colorTexture, f.depth, f.cocParams, drawTarget(node, out), blurShift, &neighbourhoods,
                     &highlightSpritePass.sprites(), &highlightTiles);
         break;
     case PassKind::RhombiLines:
@@ -711,18 +711,14 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
         if (node.pass == PassKind::Prefilter)
             upscalePass.prefilter(io);
         else
-            upscalePass.upscale(io, f.coefficients, half, blurShift, upscaleUsesTiles ? &detailTiles : nullptr,
-                                plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f);
+            upscalePass.upscale(io, f.cocParams, blurShift, upscaleUsesTiles ? &detailTiles : nullptr);
         break;
     }
     case PassKind::HighlightSprites:
-        highlightSpritePass.draw(f.depth, out->framebuffer);
+        highlightSpritePass.draw(f.cocParams, f.depth, out->framebuffer);
         break;
     case PassKind::InFocusLight:
-        inFocusLightPass.run({f.colorTexture, f.depth, texture(Image::Coc, out), near},
-                             CocPass::uniforms(f.coefficients, half, static_cast<float>(plan.highlightGain),
-                                               HighlightSpritePass::kThreshold),
-                             f.directions, samples, tileSize(), blurShift, frameHighlightTiles, out->framebuffer);
+        inFocusLightPass.run({f.colorTexture, f.depth, texture(Image::Coc, out), near}, f.cocParams, f.directions, samples, tileSize(), blurShift, frameHighlightTiles, out->framebuffer);
         break;
     case PassKind::ViewImage: {
         if (node.view == View::Depth) {
@@ -787,6 +783,9 @@ void Pipeline::Impl::render()
         highlightTiles.set(analysis.highlightTiles, blurSize, tileSize());
     if (plan.highlightSprites)
         frameHighlightTiles.set(analysis.highlightTiles, size, SceneAnalysis::kTileSize);
+    current.cocParams.set(current.coefficients, current.quality.targetFormat == TargetFormat::Rgba16F,
+                          static_cast<float>(plan.highlightGain),
+                          plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f);
     glBindVertexArray(vao.id());
     for (const Node& node : frameNodes(choices()))
         run(node, nullptr, nullptr, false);
@@ -914,7 +913,7 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
         // CoC pass's clean-up (no NaN, no negatives, within the target's range).
         const bool srgbInput = p.current.color.depth() == CV_8U;
         const bool half = p.current.quality.targetFormat == TargetFormat::Rgba16F;
-        const cv::Mat linear = srgbInput ? cv::Mat() : sanitizeLinear(p.current.color, CocPass::largestColor(half));
+        const cv::Mat linear = srgbInput ? cv::Mat() : sanitizeLinear(p.current.color, CocParams::largestColor(half));
         read.ready = passThrough(p.current.color, linear, encoding);
         p.current.timings.readbackMs = msSince(start);
         p.current.timings.totalMs = p.current.spentMs();

@@ -63,7 +63,8 @@ MethodResult GatherMethod::process(const Frame& frame, const LensSettings& lens,
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(vao_.id());
     timer_.begin(CocPass::kName);
-    cocPass_.run(color_, depth_, k, half, coc_.framebuffer);
+    cocParams_.set(k, half);
+    cocPass_.run(color_, depth_, cocParams_, coc_.framebuffer);
     timer_.end();
     timer_.begin(passName());
     gather(coc_.texture, depth_, k, out_.framebuffer);

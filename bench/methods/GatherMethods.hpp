@@ -34,6 +34,7 @@ private:
     };
     gl::VertexArray vao_ = gl::VertexArray::create();
     CocPass cocPass_;
+    CocParams cocParams_;
     gl::GpuTimer timer_;
     gl::Texture color_, depth_;
     Target coc_, out_;

@@ -13,7 +13,7 @@
 #include "bench/methods/PipelineMethod.hpp"
 #include "bench/methods/ReferenceMethod.hpp"
 #include "filter/ColorSpace.hpp"
-#include "filter/passes/CocPass.hpp"
+#include "filter/passes/CocParams.hpp"
 
 namespace defocus {
 
@@ -117,7 +117,7 @@ MethodResult Method::run(const Frame& frame, const LensSettings& lens, const Met
         // Average light, not sRGB codes: decode first; and no NaN/Inf may reach the average.
         const cv::Mat linear = frame.color.type() == CV_8UC3
                                    ? decodeSrgb(frame.color)
-                                   : sanitizeLinear(frame.color, CocPass::largestColor(
+                                   : sanitizeLinear(frame.color, CocParams::largestColor(
                                                                      settings.precision == TargetFormat::Rgba16F));
         Frame small = frame;
         cv::resize(linear, small.color, half, 0.0, 0.0, cv::INTER_AREA);

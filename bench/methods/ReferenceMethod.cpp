@@ -9,7 +9,7 @@
 #include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Lens.hpp"
-#include "filter/passes/CocPass.hpp"
+#include "filter/passes/CocParams.hpp"
 
 namespace defocus {
 
@@ -28,7 +28,7 @@ MethodResult ReferenceMethod::process(const Frame& frame, const LensSettings& le
     const cv::Mat coc = cocMap(prepared.metres, cocCoefficients(lens, frame.color.cols));
     // The same clean-up the CoC pass applies to a full-float target.
     const cv::Mat linear = frame.color.type() == CV_8UC3 ? decodeSrgb(frame.color)
-                                                         : sanitizeLinear(frame.color, CocPass::largestColor(false));
+                                                         : sanitizeLinear(frame.color, CocParams::largestColor(false));
     MethodResult result;
     result.linear = referenceScatter(linear, coc, options_);
     return result;

@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// CoC pass: uploads the lens coefficients and draws coc.frag.
+// CoC pass: binds the frame's CoC parameters and draws coc.frag.
 #include "filter/passes/CocPass.hpp"
 
 #include <cassert>
 #include <cstdint>
-#include <limits>
 
-#include "filter/passes/HexBlurPass.hpp"
 #include "filter/passes/Pass.hpp"
 
 namespace defocus {
@@ -20,51 +18,23 @@ CocPass::CocPass()
       halfSpritesProgram_("tiles.vert", "coc.frag", "coc half size sprites", {"HALF_SIZE 1", "HIGHLIGHTS 1", "SPRITES 1"}),
       quarterHighlightsProgram_("tiles.vert", "coc.frag", "coc quarter size highlights",
                                 {"QUARTER_SIZE 1", "HIGHLIGHTS 1"}),
-      uniforms_(sizeof(Uniforms), "coc params"),
       noSprites_(8 * sizeof(std::uint32_t), "coc: no sprites"),
       nearest_(GL_NEAREST, "coc nearest"),
       linear_(GL_LINEAR, "coc linear")
 {
 }
 
-namespace {
-
-// The largest colour a target keeps. Half float: its maximum. Full float: small enough that
-// hex_blur.frag's sum of up to kMaxSamples taps cannot overflow to +Inf before it is divided.
-constexpr float kLargestHalf = 65504.0f;
-constexpr float kLargestFloat = std::numeric_limits<float>::max() / HexBlurPass::kMaxSamples;
-
-} // namespace
-
-float CocPass::largestColor(bool halfTarget)
+void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocParams& params,
+                  const gl::Framebuffer& target, int sizeShift, const gl::StorageBuffer* neighbourhoods,
+                  const gl::StorageBuffer* sprites, const TileList* highlightTiles)
 {
-    return halfTarget ? kLargestHalf : kLargestFloat;
-}
-
-CocPass::Uniforms CocPass::uniforms(const CocCoefficients& k, bool halfTarget, float highlightGain,
-                                    float highlightThreshold)
-{
-    return {{k.nearScale, k.nearOffset, k.farScale, k.farOffset},
-            k.focusM,
-            k.maxCocPx,
-            k.inverseDepth ? 1 : 0,
-            largestColor(halfTarget),
-            highlightGain,
-            highlightThreshold};
-}
-
-void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-                  const gl::Framebuffer& target, float highlightGain, int sizeShift, float highlightThreshold,
-                  const gl::StorageBuffer* neighbourhoods, const gl::StorageBuffer* sprites,
-                  const TileList* highlightTiles)
-{
+    const float highlightThreshold = params.values().highlightThreshold;
+    const float highlightGain = params.values().highlightGain;
     assert(highlightThreshold <= 0.0f || (neighbourhoods && sprites));
     if (neighbourhoods)
         neighbourhoods->bind(1);
     (sprites ? *sprites : noSprites_).bind(2);
-    const Uniforms u = uniforms(k, halfTarget, highlightGain, highlightThreshold);
-    uniforms_.update(&u, sizeof u);
-    uniforms_.bind(0);
+    params.bind();
     target.bindForDraw();
     assert(sizeShift >= 0 && sizeShift <= 2);
     bindTexture(0, color.id(), nearest_.id());

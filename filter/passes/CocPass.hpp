@@ -3,9 +3,9 @@
 // or half or a quarter of it. Shader: coc.frag.
 #pragma once
 
-#include "filter/Lens.hpp"
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
+#include "filter/passes/CocParams.hpp"
 #include "filter/passes/TileList.hpp"
 
 namespace defocus {
@@ -14,14 +14,13 @@ class CocPass {
 public:
     static constexpr const char* kName = "coc";
     CocPass();
-    /// The largest colour the CoC pass keeps for a half-float or a full-float target.
-    static float largestColor(bool halfTarget);
-    /// `color`: sRGB8 or float RGB; `depth`: R32F metres with no holes; `halfTarget` keeps HDR
-    /// colour below the half-float maximum.
-    /// `highlightGain` > 1 scales near-clipped pixels of 8-bit input that get blurred (coc.frag).
+    /// `color`: sRGB8 or float RGB; `depth`: R32F metres with no holes; `params`: the frame's
+    /// (CocParams: the gather's CoC; its largest colour keeps HDR colour within the target's
+    /// range; a highlight gain > 1 scales near-clipped pixels of 8-bit input that get blurred,
+    /// coc.frag).
     /// `sizeShift` 1: the target is ((w + 1) / 2, (h + 1) / 2) and each texel averages 2x2 pixels,
     /// its CoC in half-size pixels; 2: ((w + 3) / 4, (h + 3) / 4), 4x4 pixels, quarter-size ones.
-    /// `highlightThreshold` > 0: blurred pixels brighter than this that stand out of their tile
+    /// A highlight threshold > 0 in `params`: blurred pixels brighter than this that stand out of their tile
     /// keep only that much luminance (their rest goes to bokeh sprites, HighlightSpritePass), and
     /// such pixels in focus (|CoC| < 1 px) enter the blur as what lies round them (standIn() in
     /// highlights.glsl; InFocusLightPass puts the light back);
@@ -31,23 +30,9 @@ public:
     /// the tiles of the target (SceneAnalysis::highlightTiles, 16 >> sizeShift texels a side)
     /// that have pixels above the highlight threshold: the pass treats their pixels one by one,
     /// after the plain pass over the whole target.
-    void run(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, bool halfTarget,
-             const gl::Framebuffer& target, float highlightGain = 1.0f, int sizeShift = 0,
-             float highlightThreshold = 0.0f, const gl::StorageBuffer* neighbourhoods = nullptr,
+    void run(const gl::Texture& color, const gl::Texture& depth, const CocParams& params,
+             const gl::Framebuffer& target, int sizeShift = 0, const gl::StorageBuffer* neighbourhoods = nullptr,
              const gl::StorageBuffer* sprites = nullptr, const TileList* highlightTiles = nullptr);
-
-    /// Mirrors the std140 block CocParams in coc_params.glsl (shared with upscale.frag).
-    struct Uniforms {
-        float coefficients[4];
-        float focusM;
-        float maxCocPx;
-        int inverseDepth;
-        float largestColor;
-        float highlightGain;
-        float highlightThreshold;
-    };
-    static Uniforms uniforms(const CocCoefficients& k, bool halfTarget, float highlightGain,
-                             float highlightThreshold = 0.0f);
 
 private:
     /// The plain variants, full-screen: every pixel of a frame without highlights, and the others'
@@ -58,7 +43,6 @@ private:
     /// compiled out of the others, since llvmpipe runs a branch's instructions even where no
     /// pixel takes it. QUARTER_SIZE: never with sprites (makePlan()).
     gl::Program spritesProgram_, halfHighlightsProgram_, halfSpritesProgram_, quarterHighlightsProgram_;
-    gl::UniformBuffer uniforms_;
     gl::StorageBuffer noSprites_; ///< bound for the sprite count where there are no sprites
     gl::Sampler nearest_;
     gl::Sampler linear_;

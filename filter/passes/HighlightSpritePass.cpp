@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cassert>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -48,7 +49,6 @@ HighlightSpritePass::HighlightSpritePass()
     : find_(gl::Program::compute("highlight_sprites.comp", "highlight sprites: find")),
       settle_(gl::Program::compute("highlight_sprites.comp", "highlight sprites: settle", {"SETTLE 1"})),
       draw_("highlight_sprite.vert", "highlight_sprite.frag", "highlight sprites: draw"),
-      cocParams_(sizeof(CocPass::Uniforms), "highlight sprites coc params"),
       spriteParams_(sizeof(SpriteParams), "highlight sprites params"),
       sprites_(static_cast<GLsizeiptr>(kHeaderBytes + kSpriteBytes), "highlight sprites"),
       capacity_(1),
@@ -87,9 +87,8 @@ std::size_t HighlightSpritePass::budget(std::size_t pixels, std::size_t highligh
     return std::max<std::size_t>(1, std::min(pixels / 64, highlightPixels));
 }
 
-void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k,
-                               float highlightGain, float largestColor, const ApertureShape& shape, bool nearField,
-                               const gl::StorageBuffer& neighbourhoods, const std::vector<cv::Point>& tiles,
+void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& depth, const CocParams& params,
+                               const ApertureShape& shape, bool nearField, const gl::StorageBuffer& neighbourhoods, const std::vector<cv::Point>& tiles,
                                std::size_t budget)
 {
     if (budget > capacity_) {
@@ -101,10 +100,8 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
     const std::array<std::uint32_t, 8> header{18, 0, 0, 0, static_cast<std::uint32_t>(budget), 0, 0, 0};
     sprites_.update(header.data(), static_cast<GLsizeiptr>(sizeof header));
 
-    CocPass::Uniforms u = CocPass::uniforms(k, false, highlightGain, kThreshold);
-    u.largestColor = largestColor;
-    cocParams_.update(&u, sizeof u);
-    cocParams_.bind(0);
+    assert(params.values().highlightThreshold == kThreshold);
+    params.bind();
     sprites_.bind(0);
     neighbourhoods.bind(1);
     bindTexture(0, color.id(), nearest_.id());
@@ -146,10 +143,10 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
     }
 }
 
-void HighlightSpritePass::draw(const gl::Texture& depth, const gl::Framebuffer& target)
+void HighlightSpritePass::draw(const CocParams& params, const gl::Texture& depth, const gl::Framebuffer& target)
 {
-    // The CoC and sprite parameters are the frame's, as find() left them.
-    cocParams_.bind(0);
+    // The sprite parameters are the frame's, as find() left them.
+    params.bind();
     spriteParams_.bind(1);
     sprites_.bind(0);
     bindTexture(1, depth.id(), nearest_.id());

@@ -11,9 +11,9 @@
 #include <opencv2/core.hpp>
 
 #include "filter/Aperture.hpp"
-#include "filter/Lens.hpp"
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
+#include "filter/passes/CocParams.hpp"
 
 namespace defocus {
 
@@ -30,20 +30,21 @@ public:
 
     HighlightSpritePass();
     /// Step 1, before the CoC pass: finds the sprites in `color` (sRGB8 or float RGB) and `depth`
-    /// (R32F metres, filled) with the CoC pass' settings (`k`, the gather's CoC, `highlightGain`,
-    /// `largestColor`, the tiles' `neighbourhoods`, SceneAnalysis::tileNeighbourhood) and the
-    /// aperture's (`shape`, whose gatherScale() `k` holds, `nearField`), at most `budget` of them;
+    /// (R32F metres, filled) with the CoC pass' settings (`params`, the frame's: the gather's CoC,
+    /// the highlight gain and threshold, the largest colour; the tiles' `neighbourhoods`,
+    /// SceneAnalysis::tileNeighbourhood) and the aperture's (`shape`, whose gatherScale() the
+    /// gather's CoC holds, `nearField`), at most `budget` of them;
     /// a frame with more draws none, and the CoC pass (reading sprites()) then keeps all of their
     /// light. Only the 16x16 `tiles` (SceneAnalysis::highlightTiles) are
     /// searched: no pixel elsewhere is bright enough.
-    void find(const gl::Texture& color, const gl::Texture& depth, const CocCoefficients& k, float highlightGain,
-              float largestColor, const ApertureShape& shape, bool nearField, const gl::StorageBuffer& neighbourhoods,
+    void find(const gl::Texture& color, const gl::Texture& depth, const CocParams& params, const ApertureShape& shape,
+              bool nearField, const gl::StorageBuffer& neighbourhoods,
               const std::vector<cv::Point>& tiles, std::size_t budget);
     /// Step 2: adds the sprites found to `target` (the frame's size, linear or sRGB with
     /// GL_FRAMEBUFFER_SRGB) where the gather would have spread their light (with the near field:
-    /// foreground over what is behind it too), with find()'s settings; `depth` is find()'s. A
-    /// vertex array must be bound.
-    void draw(const gl::Texture& depth, const gl::Framebuffer& target);
+    /// foreground over what is behind it too), with find()'s settings; `params` and `depth` are
+    /// find()'s. A vertex array must be bound.
+    void draw(const CocParams& params, const gl::Texture& depth, const gl::Framebuffer& target);
     /// The sprites and their count, as the GPU holds them (highlight_sprites.comp).
     const gl::StorageBuffer& sprites() const { return sprites_; }
 
@@ -56,7 +57,7 @@ private:
     void updateSpriteParams(const gl::Texture& depth, const ApertureShape& shape, bool nearField);
 
     gl::Program find_, settle_, draw_;
-    gl::UniformBuffer cocParams_, spriteParams_;
+    gl::UniformBuffer spriteParams_;
     gl::StorageBuffer sprites_;
     gl::StorageBuffer tiles_; ///< the tiles searched, (column, row) as two ints each
     std::size_t capacity_ = 0; ///< sprites the buffer holds

@@ -16,8 +16,7 @@ namespace defocus {
 // The blur reads beyond the frame its edge repeated (RhombusBlurPass); the coverage must read the
 // same taps.
 InFocusLightPass::InFocusLightPass()
-    : cocParams_(sizeof(CocPass::Uniforms), "lights in focus coc params"),
-      uniforms_(sizeof(Uniforms), "lights in focus params"),
+    : uniforms_(sizeof(Uniforms), "lights in focus params"),
       nearest_(GL_NEAREST, "lights in focus nearest", GL_CLAMP_TO_EDGE),
       linear_(GL_LINEAR, "lights in focus linear", GL_CLAMP_TO_EDGE)
 {
@@ -40,7 +39,7 @@ const gl::Program& InFocusLightPass::program(const RhombusBlurPass::Lines& lines
     return slot;
 }
 
-void InFocusLightPass::run(const Io& io, const CocPass::Uniforms& cocParams,
+void InFocusLightPass::run(const Io& io, const CocParams& params,
                            const RhombusBlurPass::Directions& directions, int taps, int nearTileSize,
                            int blurShift, const TileList& tiles, const gl::Framebuffer& target)
 {
@@ -59,8 +58,7 @@ void InFocusLightPass::run(const Io& io, const CocPass::Uniforms& cocParams,
     u.nearTileSize = nearTileSize;
     u.nearField = io.nearDiameter != nullptr ? 1 : 0;
     u.blurShift = blurShift;
-    cocParams_.update(&cocParams, sizeof cocParams);
-    cocParams_.bind(0);
+    params.bind();
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(2);
     bindTexture(0, io.color.id(), nearest_.id());

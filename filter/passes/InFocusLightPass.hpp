@@ -7,10 +7,9 @@
 
 #include <map>
 
-#include "filter/Lens.hpp"
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
-#include "filter/passes/CocPass.hpp"
+#include "filter/passes/CocParams.hpp"
 #include "filter/passes/RhombusBlurPass.hpp"
 #include "filter/passes/TileList.hpp"
 
@@ -30,11 +29,11 @@ public:
         const gl::Texture* nearDiameter;
     };
     /// Adds to `target`, the frame-sized output, the light the CoC pass held back from the
-    /// pixels in focus on `tiles` (SceneAnalysis::highlightTiles, frame-sized). `cocParams` are
-    /// the CoC pass's (CocPass::uniforms() with its highlight threshold); `directions`, `taps`,
+    /// pixels in focus on `tiles` (SceneAnalysis::highlightTiles, frame-sized). `params`: the
+    /// frame's, the CoC pass's (with its highlight threshold); `directions`, `taps`,
     /// `nearTileSize` and `blurShift` (0 full size, 1 half) the rhombus blur's. A vertex array
     /// must be bound.
-    void run(const Io& io, const CocPass::Uniforms& cocParams, const RhombusBlurPass::Directions& directions,
+    void run(const Io& io, const CocParams& params, const RhombusBlurPass::Directions& directions,
              int taps, int nearTileSize, int blurShift, const TileList& tiles, const gl::Framebuffer& target);
 
 private:
@@ -50,7 +49,6 @@ private:
     /// One program per set of line modes (compile-time in the shader, as in the blur).
     const gl::Program& program(const RhombusBlurPass::Lines& lines);
     std::map<int, gl::Program> programs_;
-    gl::UniformBuffer cocParams_;
     gl::UniformBuffer uniforms_;
     gl::Sampler nearest_;
     gl::Sampler linear_;

@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "filter/ColorSpace.hpp"
-#include "filter/passes/CocPass.hpp"
 #include "filter/passes/Pass.hpp"
 
 namespace defocus {
@@ -39,7 +38,6 @@ cv::Size tilesOf(cv::Size frame)
 SceneMeasurePass::SceneMeasurePass()
     : program_(gl::Program::compute("scene_measure.comp", "scene measure")),
       eightBitLocation_(program_.uniform("uEightBit")), countHolesLocation_(program_.uniform("uCountHoles")),
-      cocParams_(sizeof(CocPass::Uniforms), "scene measure coc params"),
       nearest_(GL_NEAREST, "scene measure nearest")
 {
     // measureScene()'s decode: the same table, so that the same bytes give the same luminance
@@ -51,7 +49,7 @@ SceneMeasurePass::SceneMeasurePass()
 }
 
 void SceneMeasurePass::run(const gl::Texture& depth, const gl::Texture& color, bool eightBit,
-                           const CocCoefficients& k, const gl::Texture* measured, gl::StorageBuffer& out)
+                           const CocParams& params, const gl::Texture* measured, gl::StorageBuffer& out)
 {
     const cv::Size tiles = tilesOf({depth.width(), depth.height()});
     const auto bytes = static_cast<GLsizeiptr>(sizeof(Header) + tiles.area() * sizeof(Tile));
@@ -60,9 +58,7 @@ void SceneMeasurePass::run(const gl::Texture& depth, const gl::Texture& color, b
     const Header zero{};
     out.update(&zero, sizeof zero);
 
-    const CocPass::Uniforms u = CocPass::uniforms(k, false, 1.0f);
-    cocParams_.update(&u, sizeof u);
-    cocParams_.bind(0);
+    params.bind();
     program_.use();
     glUniform1i(eightBitLocation_, eightBit ? 1 : 0);
     glUniform1i(countHolesLocation_, measured ? 1 : 0);

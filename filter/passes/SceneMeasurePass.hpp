@@ -9,10 +9,10 @@
 
 #include <opencv2/core.hpp>
 
-#include "filter/Lens.hpp"
 #include "filter/SceneAnalysis.hpp"
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
+#include "filter/passes/CocParams.hpp"
 
 namespace defocus {
 
@@ -22,11 +22,11 @@ public:
     SceneMeasurePass();
 
     /// Measures `depth` (R32F metres, filled) and `color`, both of the frame's size, with the
-    /// CoC of `k`: `color` is float linear, or with `eightBit` the frame's sRGB bytes undecoded
+    /// CoC of `params` (the frame's; its coefficients are all this reads): `color` is float linear, or with `eightBit` the frame's sRGB bytes undecoded
     /// (GL_RGB8, a view of the CoC pass's sRGB8 texture: Texture::view()). `measured`:
     /// DepthPrepPass::measured(), whose holes are counted; nullptr for a frame without depth.
     /// The measurement goes to `out`, made large enough; read() takes it from there.
-    void run(const gl::Texture& depth, const gl::Texture& color, bool eightBit, const CocCoefficients& k,
+    void run(const gl::Texture& depth, const gl::Texture& color, bool eightBit, const CocParams& params,
              const gl::Texture* measured, gl::StorageBuffer& out);
     /// Waits for the measurement run() put in `buffer`, of a frame of `frame` pixels, and returns
     /// it, with the pixels of the depth that had no measurement in `invalidPixels` (all of them
@@ -37,7 +37,6 @@ public:
 private:
     gl::Program program_;
     GLint eightBitLocation_ = -1, countHolesLocation_ = -1;
-    gl::UniformBuffer cocParams_;
     gl::Sampler nearest_;
 };
 

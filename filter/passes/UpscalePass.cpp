@@ -9,7 +9,6 @@
 
 #include "filter/SceneAnalysis.hpp"
 
-#include "filter/passes/CocPass.hpp"
 #include "filter/passes/Pass.hpp"
 
 namespace defocus {
@@ -41,7 +40,6 @@ UpscalePass::UpscalePass()
     : half_(1),
       quarter_(2),
       prefilter_("fullscreen.vert", "upscale_prefilter.frag", "upscale prefilter"),
-      uniforms_(sizeof(CocPass::Uniforms), "upscale params"),
       nearest_(GL_NEAREST, "upscale nearest"),
       linear_(GL_LINEAR, "upscale linear")
 {
@@ -56,13 +54,10 @@ void UpscalePass::prefilter(const Io& io)
     drawFullscreenTriangle();
 }
 
-void UpscalePass::upscale(const Io& io, const CocCoefficients& k, bool halfTarget, int sizeShift,
-                          const TileList* detailTiles, float highlightThreshold)
+void UpscalePass::upscale(const Io& io, const CocParams& params, int sizeShift, const TileList* detailTiles)
 {
     Programs& programs = sizeShift == 2 ? quarter_ : half_;
-    const CocPass::Uniforms u = CocPass::uniforms(k, halfTarget, 1.0f, highlightThreshold);
-    uniforms_.update(&u, sizeof u);
-    uniforms_.bind(0);
+    params.bind();
     io.target.bindForDraw();
     bindTexture(0, io.color.id(), nearest_.id());
     bindTexture(1, io.depth.id(), nearest_.id());

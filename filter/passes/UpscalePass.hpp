@@ -4,9 +4,9 @@
 // interpolation sharp (upscale_prefilter.frag), then the frame-sized upscale (upscale.frag).
 #pragma once
 
-#include "filter/Lens.hpp"
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
+#include "filter/passes/CocParams.hpp"
 #include "filter/passes/TileList.hpp"
 
 namespace defocus {
@@ -37,11 +37,11 @@ public:
     /// The prefilter (half size, into io.prefiltered), then the upscale (into io.target); the
     /// pipeline times them apart.
     void prefilter(const Io& io);
-    /// `sizeShift`: 1 when the blur ran at half size, 2 at quarter size. `highlightThreshold` > 0
-    /// (frames with bokeh sprites): the CoC pass's, whose cap on a light in focus the frame's
-    /// pixels keep here (InFocusLightPass puts the rest back).
-    void upscale(const Io& io, const CocCoefficients& k, bool halfTarget, int sizeShift,
-                 const TileList* detailTiles = nullptr, float highlightThreshold = 0.0f);
+    /// `params`: the frame's, the CoC pass's (its highlight threshold > 0, on frames with bokeh
+    /// sprites, is the cap on a light in focus that the frame's pixels keep here;
+    /// InFocusLightPass puts the rest back). `sizeShift`: 1 when the blur ran at half size, 2 at
+    /// quarter size.
+    void upscale(const Io& io, const CocParams& params, int sizeShift, const TileList* detailTiles = nullptr);
 
 private:
     struct Programs {
@@ -52,7 +52,6 @@ private:
     };
     Programs half_, quarter_;
     gl::Program prefilter_;
-    gl::UniformBuffer uniforms_;
     gl::Sampler nearest_;
     gl::Sampler linear_;
 };
