@@ -10,6 +10,7 @@
 #include <map>
 #include <mutex>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 #include <epoxy/gl.h>
@@ -134,10 +135,18 @@ bool ensureTexture(gl::Texture& texture, GLenum format, cv::Size size, const cha
     return true;
 }
 
-/// The range of valid depths in `depth` (any size); `lo`/`hi` unchanged when there is none.
-/// Returns the share of `depth` that is no measurement (1 when it is empty).
-double validDepthRange(const cv::Mat& depth, float& lo, float& hi)
+/// The range of valid depths in `depth` (any size: float metres, or 16-bit in `unitsPerMetre`,
+/// 0 where nothing was measured), in metres; `lo`/`hi` unchanged when there is none. Returns the
+/// share of `depth` that is no measurement (1 when it is empty).
+template <typename T>
+double validDepthRange(const cv::Mat& depth, double unitsPerMetre, float& lo, float& hi)
 {
+    const auto valid = [](T z) {
+        if constexpr (std::is_same_v<T, float>)
+            return isValidDepth(z);
+        else
+            return z > 0;
+    };
     // Rows in bands on OpenCV's threads; a minimum, a maximum and a count combine in any order.
     float low = std::numeric_limits<float>::max(), high = std::numeric_limits<float>::lowest();
     std::size_t invalid = 0;
@@ -146,11 +155,11 @@ double validDepthRange(const cv::Mat& depth, float& lo, float& hi)
         float bandLow = std::numeric_limits<float>::max(), bandHigh = std::numeric_limits<float>::lowest();
         std::size_t bandInvalid = 0;
         for (int y = range.start; y < range.end; ++y) {
-            const float* z = depth.ptr<float>(y);
+            const T* z = depth.ptr<T>(y);
             for (int x = 0; x < depth.cols; ++x)
-                if (isValidDepth(z[x])) {
-                    bandLow = std::min(bandLow, z[x]);
-                    bandHigh = std::max(bandHigh, z[x]);
+                if (valid(z[x])) {
+                    bandLow = std::min(bandLow, static_cast<float>(z[x]));
+                    bandHigh = std::max(bandHigh, static_cast<float>(z[x]));
                 } else {
                     ++bandInvalid;
                 }
@@ -161,8 +170,8 @@ double validDepthRange(const cv::Mat& depth, float& lo, float& hi)
         invalid += bandInvalid;
     });
     if (low <= high) {
-        lo = low;
-        hi = high;
+        lo = static_cast<float>(low / unitsPerMetre);
+        hi = static_cast<float>(high / unitsPerMetre);
     }
     return depth.empty() ? 1.0 : static_cast<double>(invalid) / static_cast<double>(depth.total());
 }
@@ -183,6 +192,8 @@ struct FrameContext {
     /// The frame's images, kept until its passes have run (they are skipped when all is in
     /// focus and the composite is all that is read).
     cv::Mat color, depthInput;
+    /// depthInput's units a metre where it is 16-bit (CV_16UC1); 0: float metres.
+    double depthUnits = 0.0;
     cv::Size size;
     QualitySettings quality;
     /// The gather's CoC: the lens', scaled so that the rhombi's hexagon covers the aperture's
@@ -280,6 +291,7 @@ struct Pipeline::Impl {
     /// TargetFormat::Auto: half floats here (gl::halfFloatTargets()).
     const bool halfFloatTargets = gl::halfFloatTargets(rendererName());
     DepthPrepWorkspace depthWorkspace; // prepareDepth()'s buffers, kept from frame to frame
+    cv::Mat depthMetres; // 16-bit depth in metres for prepareDepth(), kept from frame to frame
     /// Readback buffers collected and free again, for the next reads of their size.
     std::vector<gl::ReadbackBuffer> spareReadbacks;
     /// A spare readback buffer of at least `bytes` (those too small are dropped), or a new one.
@@ -345,7 +357,8 @@ struct Pipeline::Impl {
             f.colorTexture.upload(format, type, f.color.data);
     }
     /// begin()'s work on `f`: the frame, its settings, the all-in-focus exit or depth prep.
-    void begin(FrameContext& f, const Frame& frame, const LensSettings& lens, const QualitySettings& quality);
+    void begin(FrameContext& f, const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
+               double depthUnitsPerMetre);
     /// Depth prep and the scene measurement of `f`: on the GPU, the frame's images uploaded and
     /// the measurement submitted (read by plan()); on the CPU, both done and the filled depth uploaded.
     void prepare(FrameContext& f);
@@ -391,14 +404,16 @@ Pipeline::Pipeline(bool timers)
 
 Pipeline::~Pipeline() = default;
 
-void Pipeline::process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality)
+void Pipeline::process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
+                       double depthUnitsPerMetre)
 {
     CV_Assert(impl_->staged.empty());
-    begin(frame, lens, quality);
+    begin(frame, lens, quality, depthUnitsPerMetre);
     finish();
 }
 
-void Pipeline::begin(const Frame& frame, const LensSettings& lens, const QualitySettings& quality)
+void Pipeline::begin(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
+                     double depthUnitsPerMetre)
 {
     Impl& p = *impl_;
     CV_Assert(!frame.color.empty() &&
@@ -408,7 +423,7 @@ void Pipeline::begin(const Frame& frame, const LensSettings& lens, const Quality
         f = std::move(p.spareContexts.back());
         p.spareContexts.pop_back();
     }
-    p.begin(f, frame, lens, quality);
+    p.begin(f, frame, lens, quality, depthUnitsPerMetre);
     f.beginMs = msSince(f.frameStart);
     p.staged.push_back(std::move(f));
 }
@@ -427,13 +442,15 @@ void Pipeline::dropBegun()
 }
 
 void Pipeline::Impl::begin(FrameContext& f, const Frame& frame, const LensSettings& lens,
-                           const QualitySettings& quality)
+                           const QualitySettings& quality, double depthUnitsPerMetre)
 {
     f.timings = {};
     f.frameStart = Clock::now();
     f.size = frame.color.size();
     f.color = frame.color;
     f.depthInput = frame.depth;
+    f.depthUnits = depthUnitsPerMetre;
+    CV_Assert(f.depthInput.empty() || f.depthInput.type() == (f.depthUnits > 0.0 ? CV_16UC1 : CV_32FC1));
     f.quality = quality;
     if (f.quality.targetFormat == TargetFormat::Auto)
         f.quality.targetFormat = halfFloatTargets ? TargetFormat::Rgba16F : TargetFormat::Rgba32F;
@@ -461,7 +478,8 @@ void Pipeline::Impl::begin(FrameContext& f, const Frame& frame, const LensSettin
     if (quality.adaptive) {
         const auto start = Clock::now();
         float lo = f.fallbackDepth, hi = f.fallbackDepth;
-        f.invalidFraction = validDepthRange(frame.depth, lo, hi);
+        f.invalidFraction = f.depthUnits > 0.0 ? validDepthRange<std::uint16_t>(frame.depth, f.depthUnits, lo, hi)
+                                               : validDepthRange<float>(frame.depth, 1.0, lo, hi);
         const float c0 = cocPixels(lensCoc, lo), c1 = cocPixels(lensCoc, hi);
         f.timings.analysisMs = msSince(start);
         if (std::max(std::abs(c0), std::abs(c1)) < 0.5f) {
@@ -508,7 +526,8 @@ void Pipeline::Impl::prepare(FrameContext& f)
     const bool lightEdges =
         f.color.type() == CV_32FC3 && f.quality.kernel == HexagonKernel::RhombiSum && f.quality.highlightSprites;
     const bool srgbInput = f.color.depth() == CV_8U;
-    CV_Assert(f.color.isContinuous() && (f.depthInput.empty() || f.depthInput.type() == CV_32FC1));
+    CV_Assert(f.color.isContinuous());
+    const bool units = f.depthUnits > 0.0; // 16-bit depth
     auto start = Clock::now();
     if (prepareOnGpu) {
         // The frame's pixels go up as they came; only the measurement comes back, read when the
@@ -519,14 +538,15 @@ void Pipeline::Impl::prepare(FrameContext& f)
         f.hasDepth = !f.depthInput.empty();
         const cv::Mat given = f.depthInput.isContinuous() ? f.depthInput : f.depthInput.clone();
         if (f.hasDepth) {
-            ensureTexture(f.depthAsGiven, GL_R32F, given.size(), "depth as given");
-            uploads.upload(f.depthAsGiven, GL_RED, GL_FLOAT, given.data, given.total() * given.elemSize());
+            ensureTexture(f.depthAsGiven, units ? GL_R16UI : GL_R32F, given.size(), "depth as given");
+            uploads.upload(f.depthAsGiven, units ? GL_RED_INTEGER : GL_RED, units ? GL_UNSIGNED_SHORT : GL_FLOAT,
+                           given.data, given.total() * given.elemSize());
         }
         f.timings.uploadMs = msSince(start);
         start = Clock::now();
         glBindVertexArray(vao.id());
         timer.begin(DepthPrepPass::kName);
-        depthPrepPass.run(f.hasDepth ? &f.depthAsGiven : nullptr, f.fallbackDepth,
+        depthPrepPass.run(f.hasDepth ? &f.depthAsGiven : nullptr, f.depthUnits, f.fallbackDepth,
                           lightEdges ? &f.colorTexture : nullptr, f.depth, f.depthTarget);
         timer.end();
         timer.begin(SceneMeasurePass::kName);
@@ -537,7 +557,10 @@ void Pipeline::Impl::prepare(FrameContext& f)
         f.timings.depthPrepMs = msSince(start);
         f.measuring = true;
     } else {
-        prepareDepth(f.depthInput, f.size, f.fallbackDepth, depthWorkspace, f.prepared);
+        // 16-bit depth in metres first, as a 16-bit depth file is read (0 stays 0: no measurement).
+        if (units)
+            f.depthInput.convertTo(depthMetres, CV_32F, 1.0 / f.depthUnits);
+        prepareDepth(units ? depthMetres : f.depthInput, f.size, f.fallbackDepth, depthWorkspace, f.prepared);
         if (lightEdges)
             putLightEdgesAtTheirLightsDepth(f.color, f.prepared.metres);
         f.timings.depthPrepMs = msSince(start);

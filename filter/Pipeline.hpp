@@ -88,7 +88,11 @@ public:
     /// Runs the passes for `frame` (or only decides that nothing needs to run). `lens` and
     /// `quality` must have passed validate(). The frame's images are referenced, not copied,
     /// until the next process(): leave them unchanged until read() has been called.
-    void process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality);
+    /// `depthUnitsPerMetre` 0: the frame's depth is CV_32FC1 metres; otherwise CV_16UC1 in those
+    /// units (0: no measurement), uploaded as it is and converted on the GPU (converted on the
+    /// CPU where depth prep runs there).
+    void process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
+                 double depthUnitsPerMetre = 0.0);
     /// process() in two halves, so that a frame's upload and measurement go ahead of the passes
     /// of the frame before it: begin() takes `frame`, uploads it and submits its depth prep and
     /// scene measurement (on the GPU; on the CPU it does them); finish() takes the oldest frame
@@ -99,7 +103,8 @@ public:
     /// passes of N - 1 while the CPU plans N. The same output as process(). With frames begun,
     /// the GPU timer scopes of their depth prep and measurement go with the timings of the frame
     /// read before them. The images are referenced until the frame's passes have run.
-    void begin(const Frame& frame, const LensSettings& lens, const QualitySettings& quality);
+    void begin(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
+               double depthUnitsPerMetre = 0.0);
     void finish();
     /// Frames begun and not finished.
     std::size_t begun() const;

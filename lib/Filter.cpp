@@ -211,6 +211,7 @@ struct Filter::Impl {
     FrameReport report;
     /// The last process()'s frame and lens, for contactSheet() to process it again.
     std::optional<Frame> lastFrame;
+    double lastDepthUnits = 0.0; ///< its 16-bit depth's units a metre; 0: float metres
     LensSettings lastLens;
     /// submit()'s frames on their way back, oldest first, each with its report.
     struct InFlight {
@@ -229,8 +230,10 @@ struct Filter::Impl {
     void fillReport(std::size_t index) { fillReport(index, pipeline->timings(), report); }
     void fillReport(std::size_t index, const FrameTimings& t, FrameReport& r) const;
     /// The frame process(), submit() and processTextures() filter from the caller's images, and its lens (the
-    /// autofocus stepped); throws InputError and SettingsError as process() documents.
-    Frame admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens);
+    /// autofocus stepped); throws InputError and SettingsError as process() documents. 16-bit
+    /// depth stays as it came, its units a metre in `depthUnits` (0: the depth is float metres).
+    Frame admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens,
+                double& depthUnits);
     /// admit() and the frame begun on the pipeline (whose context must be current): uploaded and
     /// measured; the frame and its lens kept for the report.
     void beginFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
@@ -365,7 +368,8 @@ const Settings& Filter::settings() const
     return impl_->settings;
 }
 
-Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens)
+Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens,
+                          double& depthUnits)
 {
     Impl& p = *this;
     if (color.empty())
@@ -384,16 +388,20 @@ Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double tim
                                      "channel is ignored) or float (CV_32FC3)",
                                      describeType(color)));
     }
+    depthUnits = 0.0;
     if (!depth.empty()) {
-        if (depth.type() == CV_16UC1)
-            // As a 16-bit depth file is read: 0 (no measurement) stays 0.
-            depth.convertTo(frame.depth, CV_32F, 1.0 / p.settings.depthScale);
-        else if (depth.type() == CV_32FC1)
+        if (depth.type() == CV_16UC1) {
+            // As it came: the pipeline converts it where it prepares the depth (on the GPU, after
+            // an upload of half the bytes of float metres).
+            frame.depth = depth;
+            depthUnits = p.settings.depthScale;
+        } else if (depth.type() == CV_32FC1) {
             frame.depth = depth; // read row by row: a view of a larger image needs no copy
-        else
+        } else {
             throw InputError(fmt::format("depth image is {}; expected 16-bit single-channel (CV_16UC1, {} units per "
                                          "metre) or float metres (CV_32FC1)",
                                          describeType(depth), p.settings.depthScale));
+        }
         if (const std::string problem = depthFitProblem(color.size(), "colour", depth.size(), "depth");
             !problem.empty())
             throw InputError(problem);
@@ -403,11 +411,16 @@ Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double tim
     frame.name = fmt::format("frame {}", p.frames);
 
     frameLens = p.lens;
+    // The autofocus reads metres: 16-bit depth converted for it alone (0 stays 0: no measurement).
+    cv::Mat converted;
+    if (depthUnits > 0.0 && p.settings.autofocus.mode != AutofocusOptions::Mode::Off)
+        depth.convertTo(converted, CV_32F, 1.0 / depthUnits);
+    const cv::Mat& metres = depthUnits > 0.0 ? converted : frame.depth;
     switch (p.settings.autofocus.mode) {
     case AutofocusOptions::Mode::Off: break;
     case AutofocusOptions::Mode::FirstFrame:
         if (!p.focusChosen) {
-            p.firstFrameFocusM = centreDepth(frame.depth, kAutoWindow, kAutoFallbackM);
+            p.firstFrameFocusM = centreDepth(metres, kAutoWindow, kAutoFallbackM);
             LensSettings measured = frameLens;
             measured.focusM = p.firstFrameFocusM;
             if (const auto issues = validate(measured); !issues.empty())
@@ -418,7 +431,7 @@ Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double tim
         break;
     case AutofocusOptions::Mode::Follow: {
         const double dt = frameInterval(p.previousTimestamp, timestampS, kFallbackFrameS);
-        frameLens.focusM = frame.depth.empty() ? p.follow->advance(dt) : p.follow->update(frame.depth, dt);
+        frameLens.focusM = metres.empty() ? p.follow->advance(dt) : p.follow->update(metres, dt);
         // Nearer than the lens can focus: the nearest it can.
         frameLens.focusM = std::max(frameLens.focusM, frameLens.focalLengthMm * 1e-3 * 1.01);
         break;
@@ -489,9 +502,11 @@ std::vector<Timings::Pass> Filter::finishGpuTimings()
 void Filter::Impl::beginFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
 {
     LensSettings frameLens;
-    Frame frame = admit(color, depth, timestampS, frameLens);
-    pipeline->begin(frame, frameLens, quality);
+    double depthUnits = 0.0;
+    Frame frame = admit(color, depth, timestampS, frameLens, depthUnits);
+    pipeline->begin(frame, frameLens, quality, depthUnits);
     lastFrame = std::move(frame);
+    lastDepthUnits = depthUnits;
     lastLens = frameLens;
 }
 
@@ -576,7 +591,8 @@ cv::Mat Filter::contactSheet()
     cv::Mat sheet = defocus::contactSheet(tiles);
     // Processed again so that the timings are a plain frame's, not the views' reads.
     const Encoding encoding = toEncoding(p.settings.output);
-    pipeline.run(*p.lastFrame, p.lastLens, p.quality, toView(p.settings.view), encoding);
+    pipeline.process(*p.lastFrame, p.lastLens, p.quality, p.lastDepthUnits);
+    pipeline.read(toView(p.settings.view), encoding);
     p.fillReport(p.frames - 1);
     return sheet;
 }

@@ -53,14 +53,30 @@ float upsampled(sampler2D coarse, ivec2 p)
 
 #if defined(SPLIT)
 
+#if defined(UNITS)
+// R16UI as a 16-bit depth file or camera gives it, 0 where nothing was measured; any size.
+layout(binding = 0) uniform usampler2D uDepth;
+// A unit in metres, as a float (DepthPrepPass::kMetresPerUnitLocation). A product is correctly
+// rounded (a quotient may be 2.5 ulp off), so the metres are those cv::Mat::convertTo makes.
+layout(location = 2) uniform float uMetresPerUnit;
+float metresAt(ivec2 texel)
+{
+    return float(texelFetch(uDepth, texel, 0).r) * uMetresPerUnit;
+}
+#else
 layout(binding = 0) uniform sampler2D uDepth; // R32F metres as it came, any size
+float metresAt(ivec2 texel)
+{
+    return texelFetch(uDepth, texel, 0).r;
+}
+#endif
 
 void main()
 {
     const ivec2 p = ivec2(gl_FragCoord.xy);
     // cv::resize's INTER_NEAREST: source pixel floor(p * source size / frame size).
     const ivec2 source = textureSize(uDepth, 0);
-    const float z = texelFetch(uDepth, min(p * source / uSize, source - 1), 0).r;
+    const float z = metresAt(min(p * source / uSize, source - 1));
     const bool valid = isValidDepth(z);
     outLevel = vec2(valid ? z : 0.0, valid ? 1.0 : 0.0);
 }

@@ -266,6 +266,52 @@ TEST_P(DepthPrepOnGpu, FramesBegunAheadGiveTheSerialFrames)
     }
 }
 
+// Defects caught: 16-bit depth read as metres (its units not divided out), its zeros taken as
+// depths instead of holes, the R16UI upload given the wrong format, the units ignored where the
+// CPU prepares the depth, the all-in-focus exit reading 16-bit pixels as floats, a GPU conversion
+// that rounds otherwise than cv::Mat::convertTo (a division, which GLSL lets be 2.5 ulp off,
+// where a product is correctly rounded). The TUM frame's depth in its file's units (5000 a metre)
+// gives the frame its metres give, as convertTo makes them, to the byte, on the GPU and on the CPU.
+TEST_P(DepthPrepOnGpu, SixteenBitDepthGivesTheFrameItsMetresGive)
+{
+    constexpr double kUnits = 5000.0;
+    Frame units = tumFrame(), metres = units;
+    units.depth.convertTo(units.depth, CV_16U, kUnits);
+    units.depth.convertTo(metres.depth, CV_32F, 1.0 / kUnits);
+    ASSERT_GT(cv::countNonZero(units.depth == 0), 1000) << "the Kinect frame has holes";
+    for (const bool onGpu : {true, false}) {
+        Pipeline fromUnits, fromMetres;
+        fromUnits.prepareOnGpu(onGpu);
+        fromMetres.prepareOnGpu(onGpu);
+        const char* which = onGpu ? "GPU" : "CPU";
+        fromUnits.process(units, tumLens(), GetParam().quality, kUnits);
+        fromMetres.process(metres, tumLens(), GetParam().quality);
+        EXPECT_EQ(fromUnits.invalidDepthFraction(), fromMetres.invalidDepthFraction()) << which;
+        const cv::Mat a = fromUnits.read(View::Composite, Encoding::Srgb8);
+        const cv::Mat b = fromMetres.read(View::Composite, Encoding::Srgb8);
+        EXPECT_EQ(cv::norm(fromUnits.filledDepth(), fromMetres.filledDepth(), cv::NORM_INF), 0.0) << which;
+        EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0) << which;
+
+        // All in focus at 1 m: decided from the 16-bit range, holes counted as the float's.
+        Frame flat = units;
+        flat.depth.setTo(static_cast<std::uint16_t>(kUnits), flat.depth != 0);
+        Frame flatMetres = metres;
+        flatMetres.depth.setTo(1.0f, flatMetres.depth != 0.0f);
+        fromUnits.process(flat, tumLens(), GetParam().quality, kUnits);
+        fromMetres.process(flatMetres, tumLens(), GetParam().quality);
+        if (GetParam().quality.adaptive) {
+            EXPECT_TRUE(fromUnits.plan().allInFocus) << which;
+        }
+        // The exit taken before any depth prep (no tiles analysed) where the metres take it.
+        EXPECT_EQ(fromUnits.analysis().tiles, fromMetres.analysis().tiles) << which;
+        EXPECT_EQ(fromUnits.invalidDepthFraction(), fromMetres.invalidDepthFraction()) << which;
+        EXPECT_EQ(cv::norm(fromUnits.read(View::Composite, Encoding::Srgb8),
+                           fromMetres.read(View::Composite, Encoding::Srgb8), cv::NORM_INF),
+                  0.0)
+            << which;
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Presets, DepthPrepOnGpu, ::testing::ValuesIn(test::presetsAndKernels()),
                          [](const ::testing::TestParamInfo<test::NamedQuality>& p) { return p.param.name; });
 

@@ -3,6 +3,8 @@
 #include "filter/passes/DepthPrepPass.hpp"
 
 #include <algorithm>
+#include <string>
+#include <vector>
 
 #include "filter/passes/Pass.hpp"
 
@@ -10,16 +12,20 @@ namespace defocus {
 
 namespace {
 
-gl::Program program(const char* step, const char* name)
+gl::Program program(const char* step, const char* name, const char* variant = nullptr)
 {
-    return gl::Program("fullscreen.vert", "depth_prep.frag", name, {std::string(step) + " 1"});
+    std::vector<std::string> defines{std::string(step) + " 1"};
+    if (variant)
+        defines.push_back(std::string(variant) + " 1");
+    return gl::Program("fullscreen.vert", "depth_prep.frag", name, defines);
 }
 
 } // namespace
 
 DepthPrepPass::DepthPrepPass()
-    : split_(program("SPLIT", "depth prep: split")), push_(program("PUSH", "depth prep: push")),
-      pull_(program("PULL", "depth prep: pull")), fill_(program("FILL", "depth prep: fill")),
+    : split_(program("SPLIT", "depth prep: split")),
+      splitUnits_(program("SPLIT", "depth prep: split, 16-bit units", "UNITS")),
+      push_(program("PUSH", "depth prep: push")), pull_(program("PULL", "depth prep: pull")), fill_(program("FILL", "depth prep: fill")),
       lightEdges_(program("LIGHT_EDGES", "depth prep: light edges")), nearest_(GL_NEAREST, "depth prep nearest")
 {
 }
@@ -32,8 +38,9 @@ void DepthPrepPass::draw(const gl::Program& program, const gl::Framebuffer& targ
     drawFullscreenTriangle();
 }
 
-void DepthPrepPass::run(const gl::Texture* depth, float fallbackM, const gl::Texture* lightColor,
-                        const gl::Texture& filledDepth, const gl::Framebuffer& filled)
+void DepthPrepPass::run(const gl::Texture* depth, double unitsPerMetre, float fallbackM,
+                        const gl::Texture* lightColor, const gl::Texture& filledDepth,
+                        const gl::Framebuffer& filled)
 {
     const int width = filled.width(), height = filled.height();
     if (lightColor && (!unlit_ || unlit_.width() != width || unlit_.height() != height)) {
@@ -72,7 +79,13 @@ void DepthPrepPass::run(const gl::Texture* depth, float fallbackM, const gl::Tex
                 levels_[i].filledTarget = gl::Framebuffer(levels_[i].filled, "depth pyramid, filled");
             }
         glBindTextureUnit(0, depth->id());
-        draw(split_, levels_[0].pyramidTarget);
+        if (unitsPerMetre > 0.0) {
+            splitUnits_.use();
+            glUniform1f(kMetresPerUnitLocation, static_cast<float>(1.0 / unitsPerMetre));
+            draw(splitUnits_, levels_[0].pyramidTarget);
+        } else {
+            draw(split_, levels_[0].pyramidTarget);
+        }
         for (std::size_t i = 1; i < count; ++i) {
             glBindTextureUnit(0, levels_[i - 1].pyramid.id());
             draw(push_, levels_[i].pyramidTarget);

@@ -19,12 +19,12 @@ public:
     DepthPrepPass();
 
     /// Fills `filledDepth` (R32F, the frame's size; `filled` its framebuffer) from `depth` (R32F
-    /// metres; nullptr: the frame has no depth, and all of it sits at `fallbackM`, as when no
-    /// pixel of `depth` is a measurement). `lightColor`: a float frame's linear colour, whose
+    /// metres, or with `unitsPerMetre` > 0 R16UI in those units; nullptr: the frame has no depth,
+    /// and all of it sits at `fallbackM`, as when no pixel of `depth` is a measurement). `lightColor`: a float frame's linear colour, whose
     /// pixels above white take the depth of the brightest nearer pixel round them; nullptr: no
     /// such step. Needs a vertex array bound (the full-screen triangle).
-    void run(const gl::Texture* depth, float fallbackM, const gl::Texture* lightColor, const gl::Texture& filledDepth,
-             const gl::Framebuffer& filled);
+    void run(const gl::Texture* depth, double unitsPerMetre, float fallbackM, const gl::Texture* lightColor,
+             const gl::Texture& filledDepth, const gl::Framebuffer& filled);
     /// The frame's size, RG32F: g is 1 where the last run's depth had a measurement, 0 at its
     /// holes (SceneMeasurePass counts them). Empty until a run with depth.
     const gl::Texture& measured() const { return levels_.empty() ? none_ : levels_.front().pyramid; }
@@ -39,10 +39,11 @@ private:
     /// depth_prep.frag's uniforms, at explicit locations.
     static constexpr GLint kSizeLocation = 0;     ///< uSize: the target's
     static constexpr GLint kFallbackLocation = 1; ///< uFallbackM (FILL)
+    static constexpr GLint kMetresPerUnitLocation = 2; ///< uMetresPerUnit (SPLIT of 16-bit depth)
     /// Draws `program` over the whole of `target`.
     static void draw(const gl::Program& program, const gl::Framebuffer& target);
 
-    gl::Program split_, push_, pull_, fill_, lightEdges_;
+    gl::Program split_, splitUnits_, push_, pull_, fill_, lightEdges_;
     gl::Sampler nearest_;
     /// Level 0 has the frame's size, each next one half the last (rounded up), down to 1x1.
     std::vector<Level> levels_;

@@ -194,7 +194,8 @@ public:
     /// `color`: BGR, CV_8UC3 sRGB-encoded (CV_8UC4: BGRx, uploaded as it is, the fourth channel
     /// ignored; Settings::Output::Srgb8Bgra returns the same four bytes a pixel) or CV_32FC3
     /// scene-linear. `depth`: along the view axis, CV_16UC1 in Settings::depthScale units per
-    /// metre or CV_32FC1 metres; 0, NaN and infinities mean "no measurement" (filled from valid
+    /// metre (uploaded as it is and converted on the GPU; on the CPU where depth prep runs there)
+    /// or CV_32FC1 metres; 0, NaN and infinities mean "no measurement" (filled from valid
     /// neighbours); any size with the colour's aspect ratio (resized by nearest neighbour); empty
     /// = all in focus. Either may be a view into a larger image (`image(cv::Rect(...))`; the
     /// colour is copied then). `timestampS`: capture time, seconds (AutofocusOptions::Mode::Follow steps by the time
