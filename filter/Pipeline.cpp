@@ -238,6 +238,17 @@ struct FrameContext {
     /// all-in-focus exit, from the look at the depth range that decided it.
     double invalidFraction = 0.0;
     float nearestDepth = 0.0f, farthestDepth = 0.0f; ///< the filled depth's range (the depth view)
+
+    /// What finish() found and decided, and what of the frame graph has run: the analysis, the
+    /// plan, whether the frame's nodes ran, which pooled target each image has (nullptr until a
+    /// node writes it) and which images the nodes wrote.
+    SceneAnalysis analysis;
+    FramePlan plan;
+    bool rendered = false;
+    bool useTiles = false;         ///< the blurs draw the plan's blur tiles and copy the rest
+    bool upscaleUsesTiles = false; ///< the upscale puts detail back on the plan's tiles only
+    std::array<Target*, kImageCount> images{};
+    std::vector<bool> written = std::vector<bool>(kImageCount, false);
 };
 
 struct Pipeline::Impl {
@@ -263,14 +274,10 @@ struct Pipeline::Impl {
     TileList highlightTiles; ///< where the CoC pass treats highlights pixel by pixel
     TileList frameHighlightTiles; ///< the same tiles in the frame's pixels (InFocusLightPass)
     gl::StorageBuffer neighbourhoods; ///< SceneAnalysis::tileNeighbourhood, for the bokeh sprites
-    bool upscaleUsesTiles = false;
     gl::GpuTimer timer;
 
-    /// The blur targets (FrameGraph's pooled images), and the frame's own: which target each
-    /// image has (nullptr until a node writes it) and what the frame's nodes have written.
+    /// The blur targets (FrameGraph's pooled images); the frame context says which it holds.
     TargetPool pool;
-    std::array<Target*, kImageCount> images{};
-    std::vector<bool> written = std::vector<bool>(kImageCount, false);
     Target outSrgb, outLinear;
     float viewLow = 0.0f, viewHigh = 0.0f; ///< the last depth or CoC view's legend
     gl::Texture nearDiameter;            ///< per tile, R32F
@@ -306,10 +313,6 @@ struct Pipeline::Impl {
         return gl::ReadbackBuffer(bytes, "readback");
     }
 
-    SceneAnalysis analysis;
-    FramePlan plan;
-    bool rendered = false;
-    bool useTiles = false; ///< the blurs draw the plan's blur tiles and copy the rest
     std::size_t gpuFrameIndex = 0; ///< frame whose GPU scopes are pending in the timer
 
     /// The frame's nodes (FrameGraph: frameNodes()), once a frame.
@@ -322,7 +325,7 @@ struct Pipeline::Impl {
     /// The plan's choices, which pick the graph's nodes.
     GraphChoices choices() const
     {
-        return {current.quality.kernel, blurShift != 0, plan.nearField, plan.highlightSprites};
+        return {current.quality.kernel, blurShift != 0, current.plan.nearField, current.plan.highlightSprites};
     }
     /// The frame's read-back time from `readStart`, its total, and the GPU times it collected.
     void finishTimings(Clock::time_point readStart);
@@ -502,19 +505,19 @@ void Pipeline::finish()
     f.finishStart = Clock::now();
     p.size = f.size;
     p.setBlurShift(f.quality.resolution == Resolution::Half ? 1 : 0);
-    p.rendered = false;
-    p.plan = {};
-    p.analysis = {};
+    p.current.rendered = false;
+    p.current.plan = {};
+    p.current.analysis = {};
     if (f.inFocusExit) {
-        p.analysis.minCoc = f.exitMinCoc;
-        p.analysis.maxCoc = f.exitMaxCoc;
-        p.plan.allInFocus = true;
+        p.current.analysis.minCoc = f.exitMinCoc;
+        p.current.analysis.maxCoc = f.exitMaxCoc;
+        p.current.plan.allInFocus = true;
         return;
     }
     const auto start = Clock::now();
     p.planFrame();
     f.timings.analysisMs += msSince(start);
-    if (!(f.quality.adaptive && p.plan.allInFocus))
+    if (!(f.quality.adaptive && p.current.plan.allInFocus))
         p.render();
 }
 
@@ -597,11 +600,11 @@ void Pipeline::Impl::planFrame()
     cv::minMaxLoc(f.measurement.tileMaxDepth, nullptr, &hi);
     f.nearestDepth = static_cast<float>(lo);
     f.farthestDepth = static_cast<float>(hi);
-    analysis = finishAnalysis(f.measurement, f.coefficients, f.invalidFraction);
-    const bool allInFocus = plan.allInFocus && f.quality.adaptive;
+    f.analysis = finishAnalysis(f.measurement, f.coefficients, f.invalidFraction);
+    const bool allInFocus = f.plan.allInFocus && f.quality.adaptive;
     // Highlights to treat: the plan's (FramePlan::highlights) on a frame not all in focus, which
     // makePlan() derives from the analysis alone, whatever size it picks.
-    const bool lights = analysis.hasHighlights() && !analysis.allInFocus();
+    const bool lights = f.analysis.hasHighlights() && !f.analysis.allInFocus();
     const bool eightBit = f.color.depth() == CV_8U;
     const double highlightGain = eightBit && lights ? f.quality.highlightGain : 1.0;
     // Sprites where a blurred pixel can be brighter than white: float input's highlights, or
@@ -609,36 +612,36 @@ void Pipeline::Impl::planFrame()
     // bright surfaces (HighlightSpritePass::kMostHighlightPixels).
     const bool sprites = f.quality.highlightSprites && f.quality.kernel == HexagonKernel::RhombiSum && lights &&
                          (!eightBit || highlightGain > 1.0) &&
-                         analysis.highlightFraction <= HighlightSpritePass::kMostHighlightPixels;
+                         f.analysis.highlightFraction <= HighlightSpritePass::kMostHighlightPixels;
     // Quarter size only on frames without bokeh sprites: the rims of the lights' hexagons, which
     // the gather draws up to white, came out 4 px soft at quarter size (the corpus enlarged 3x,
     // `defocus-bench accuracy --scale 3`: 0.38 dB less in the median, most of it in the lights'
     // zone; docs/benchmarks.md).
-    plan = makePlan(analysis, f.quality.nearField, f.quality.kernel, f.quality.resolution, f.quality.samples,
+    f.plan = makePlan(f.analysis, f.quality.nearField, f.quality.kernel, f.quality.resolution, f.quality.samples,
                     f.quality.quarterOnLargeBlur && !sprites);
-    setBlurShift(plan.blurShift);
-    plan.highlightGain = highlightGain;
-    plan.highlightSprites = sprites;
-    plan.gatherScale = f.gatherScale;
-    plan.allInFocus = plan.allInFocus || allInFocus;
+    setBlurShift(f.plan.blurShift);
+    f.plan.highlightGain = highlightGain;
+    f.plan.highlightSprites = sprites;
+    f.plan.gatherScale = f.gatherScale;
+    f.plan.allInFocus = f.plan.allInFocus || allInFocus;
 }
 
 void Pipeline::Impl::uploadNearDiameter()
 {
-    ensureTexture(nearDiameter, GL_R32F, analysis.tiles, "near diameter per tile");
-    CV_Assert(analysis.tileNearDiameter.isContinuous());
+    ensureTexture(nearDiameter, GL_R32F, current.analysis.tiles, "near diameter per tile");
+    CV_Assert(current.analysis.tileNearDiameter.isContinuous());
     if (blurShift == 0) {
-        nearDiameter.upload(GL_RED, GL_FLOAT, analysis.tileNearDiameter.data);
+        nearDiameter.upload(GL_RED, GL_FLOAT, current.analysis.tileNearDiameter.data);
     } else {
         // The analysis measured the frame's pixels; the blur counts half-size ones.
-        const cv::Mat scaled = analysis.tileNearDiameter * (1.0 / (1 << blurShift));
+        const cv::Mat scaled = current.analysis.tileNearDiameter * (1.0 / (1 << blurShift));
         nearDiameter.upload(GL_RED, GL_FLOAT, scaled.data);
     }
 }
 
 Target& Pipeline::Impl::image(Image which)
 {
-    Target*& held = images[static_cast<std::size_t>(which)];
+    Target*& held = current.images[static_cast<std::size_t>(which)];
     if (!held) {
         assert(imageInfo(which).pooled);
         held = &pool.take(current.quality.targetFormat == TargetFormat::Rgba16F ? GL_RGBA16F : GL_RGBA32F, blurSize,
@@ -656,7 +659,7 @@ const gl::Texture& Pipeline::Impl::texture(Image which, const Target* out)
     case Image::Output: return out->texture;
     default: break;
     }
-    assert(written[static_cast<std::size_t>(which)]);
+    assert(current.written[static_cast<std::size_t>(which)]);
     return image(which).texture;
 }
 
@@ -673,10 +676,10 @@ const gl::Framebuffer& Pipeline::Impl::drawTarget(const Node& node, const Target
 
 void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuffer* caller, bool bgra)
 {
-    const FrameContext& f = current;
+    FrameContext& f = current;
     const int samples = f.quality.samples;
-    const gl::Texture* near = plan.nearField ? &nearDiameter : nullptr;
-    const TileList* tiles = useTiles ? &blurTiles : nullptr;
+    const gl::Texture* near = f.plan.nearField ? &nearDiameter : nullptr;
+    const TileList* tiles = f.useTiles ? &blurTiles : nullptr;
     // McIntosh et al.'s first pass runs along an edge of the hexagon. Edges and corners point
     // the same ways (mod 60 deg), so the edge nearest an axis is the rhombi's u1: with a corner
     // on top (rotation 0) the edges are vertical and the passes run at 90 and 90 +- 120 deg; with
@@ -688,11 +691,11 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
     case PassKind::Coc:
         // The bokeh sprites first: the CoC pass leaves their light out of the gather if they fit
         // the frame's budget.
-        if (plan.highlightSprites)
-            highlightSpritePass.find(f.colorTexture, f.depth, f.cocParams, f.aperture, plan.nearField, neighbourhoods,
-                                     analysis.highlightTiles,
+        if (f.plan.highlightSprites)
+            highlightSpritePass.find(f.colorTexture, f.depth, f.cocParams, f.aperture, f.plan.nearField,
+                                     neighbourhoods, f.analysis.highlightTiles,
                                      HighlightSpritePass::budget(static_cast<std::size_t>(size.area()),
-                                                                 analysis.highlightPixels));
+                                                                 f.analysis.highlightPixels));
         cocPass.run(f.colorTexture, f.depth, f.cocParams, drawTarget(node, out), blurShift, &neighbourhoods,
                     &highlightSpritePass.sprites(), &highlightTiles);
         break;
@@ -703,15 +706,15 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
         const bool fused = node.pass == PassKind::RhombiComposite;
         const gl::Framebuffer& target = drawTarget(node, out);
         rhombusBlurPass.run({input(0), first ? nullptr : &input(1), near, target}, first, f.directions, samples,
-                            tileSize(), tiles, fused, plan.unrolledTaps);
-        if (useTiles)
+                            tileSize(), tiles, fused, f.plan.unrolledTaps);
+        if (f.useTiles)
             copyPass.run(input(0), copyTiles, target, !fused);
         break;
     }
     case PassKind::McIntoshBlur: {
         const gl::Framebuffer& target = drawTarget(node, out);
         hexBlurPass.run(input(0), f.depth, angle, samples, target, tiles);
-        if (useTiles)
+        if (f.useTiles)
             copyPass.run(input(0), copyTiles, target);
         break;
     }
@@ -722,8 +725,8 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
         if (f.quality.kernel == HexagonKernel::RhombiSum)
             compositePass.runSum(input(0), input(1), drawTarget(node, out));
         else
-            compositePass.run(input(0), input(1), drawTarget(node, out), plan.nearField ? &input(2) : nullptr,
-                              plan.nearField ? &input(3) : nullptr);
+            compositePass.run(input(0), input(1), drawTarget(node, out), f.plan.nearField ? &input(2) : nullptr,
+                              f.plan.nearField ? &input(3) : nullptr);
         break;
     case PassKind::Prefilter:
     case PassKind::Upscale: {
@@ -734,7 +737,7 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
         if (node.pass == PassKind::Prefilter)
             upscalePass.prefilter(io);
         else
-            upscalePass.upscale(io, f.cocParams, blurShift, upscaleUsesTiles ? &detailTiles : nullptr);
+            upscalePass.upscale(io, f.cocParams, blurShift, f.upscaleUsesTiles ? &detailTiles : nullptr);
         break;
     }
     case PassKind::HighlightSprites:
@@ -763,57 +766,58 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
     }
     timer.end();
     for (const Image image : node.writes)
-        written[static_cast<std::size_t>(image)] = true;
+        f.written[static_cast<std::size_t>(image)] = true;
 }
 
 void Pipeline::Impl::render()
 {
-    if (!current.depthPrepared)
+    FrameContext& f = current;
+    if (!f.depthPrepared)
         planFrame(); // the all-in-focus exit, rendered for a view or readTarget()
     const auto start = Clock::now();
     pool.nextFrame();
-    images.fill(nullptr);
-    std::fill(written.begin(), written.end(), false);
+    f.images.fill(nullptr);
+    std::fill(f.written.begin(), f.written.end(), false);
 
     // Tiles in focus are copied, not blurred, when enough of them are: a thousand small quads
     // cost the rasteriser more than one full-screen triangle (on llvmpipe, drawing 1181 of 1200
     // tiles took 25 % longer than the whole frame), so a few copy tiles are not worth it.
-    useTiles = current.quality.adaptive && !plan.copyTiles.empty() &&
-               plan.copyTiles.size() * 4 >= plan.copyTiles.size() + plan.blurTiles.size();
-    if (useTiles) {
-        blurTiles.set(plan.blurTiles, blurSize, tileSize());
-        copyTiles.set(plan.copyTiles, blurSize, tileSize());
+    f.useTiles = f.quality.adaptive && !f.plan.copyTiles.empty() &&
+                 f.plan.copyTiles.size() * 4 >= f.plan.copyTiles.size() + f.plan.blurTiles.size();
+    if (f.useTiles) {
+        blurTiles.set(f.plan.blurTiles, blurSize, tileSize());
+        copyTiles.set(f.plan.copyTiles, blurSize, tileSize());
     }
     // The upscale's detail on tiles by the same rule: when a quarter of them only interpolate.
-    upscaleUsesTiles = current.quality.adaptive && blurShift != 0 &&
-                       plan.detailTiles.size() * 4 <= static_cast<std::size_t>(analysis.tiles.area()) * 3;
-    if (upscaleUsesTiles)
-        detailTiles.set(plan.detailTiles, size, SceneAnalysis::kTileSize);
-    if (plan.nearField) {
+    f.upscaleUsesTiles = f.quality.adaptive && blurShift != 0 &&
+                         f.plan.detailTiles.size() * 4 <= static_cast<std::size_t>(f.analysis.tiles.area()) * 3;
+    if (f.upscaleUsesTiles)
+        detailTiles.set(f.plan.detailTiles, size, SceneAnalysis::kTileSize);
+    if (f.plan.nearField) {
         uploadNearDiameter();
-        if (current.quality.kernel == HexagonKernel::McIntoshMin)
-            nearTiles.set(plan.nearTiles, blurSize, tileSize());
+        if (f.quality.kernel == HexagonKernel::McIntoshMin)
+            nearTiles.set(f.plan.nearTiles, blurSize, tileSize());
     }
-    if (plan.highlightSprites) {
-        CV_Assert(analysis.tileNeighbourhood.type() == CV_32FC4 && analysis.tileNeighbourhood.isContinuous());
-        const auto bytes = static_cast<GLsizeiptr>(analysis.tileNeighbourhood.total() * sizeof(cv::Vec4f));
+    if (f.plan.highlightSprites) {
+        CV_Assert(f.analysis.tileNeighbourhood.type() == CV_32FC4 && f.analysis.tileNeighbourhood.isContinuous());
+        const auto bytes = static_cast<GLsizeiptr>(f.analysis.tileNeighbourhood.total() * sizeof(cv::Vec4f));
         if (neighbourhoods.size() != bytes)
             neighbourhoods = gl::StorageBuffer(bytes, "tile neighbourhoods");
-        neighbourhoods.update(analysis.tileNeighbourhood.data, bytes);
+        neighbourhoods.update(f.analysis.tileNeighbourhood.data, bytes);
     }
     // Highlight recovery only for 8-bit frames that have clipped pixels (the plan's highlights).
-    if (plan.highlightSprites || plan.highlightGain > 1.0)
-        highlightTiles.set(analysis.highlightTiles, blurSize, tileSize());
-    if (plan.highlightSprites)
-        frameHighlightTiles.set(analysis.highlightTiles, size, SceneAnalysis::kTileSize);
-    current.cocParams.set(current.coefficients, current.quality.targetFormat == TargetFormat::Rgba16F,
-                          static_cast<float>(plan.highlightGain),
-                          plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f);
+    if (f.plan.highlightSprites || f.plan.highlightGain > 1.0)
+        highlightTiles.set(f.analysis.highlightTiles, blurSize, tileSize());
+    if (f.plan.highlightSprites)
+        frameHighlightTiles.set(f.analysis.highlightTiles, size, SceneAnalysis::kTileSize);
+    f.cocParams.set(f.coefficients, f.quality.targetFormat == TargetFormat::Rgba16F,
+                          static_cast<float>(f.plan.highlightGain),
+                          f.plan.highlightSprites ? HighlightSpritePass::kThreshold : 0.0f);
     glBindVertexArray(vao.id());
     for (const Node& node : frameNodes(choices()))
         run(node, nullptr, nullptr, false);
-    current.timings.renderMs = msSince(start);
-    rendered = true;
+    f.timings.renderMs = msSince(start);
+    f.rendered = true;
 }
 
 Target& Pipeline::Impl::output(Encoding encoding)
@@ -826,10 +830,10 @@ Target& Pipeline::Impl::output(Encoding encoding)
 
 void Pipeline::Impl::renderView(View view, const Target& out, const gl::Framebuffer* caller, bool bgra)
 {
-    if (!rendered)
+    if (!current.rendered)
         render();
     glBindVertexArray(vao.id());
-    for (const Node& node : viewNodes(choices(), view, written, caller != nullptr))
+    for (const Node& node : viewNodes(choices(), view, current.written, caller != nullptr))
         run(node, &out, caller, bgra);
 }
 
@@ -931,7 +935,7 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
     read.size = p.size;
     read.encoding = encoding;
     read.view = view;
-    if (view == View::Composite && !p.rendered) {
+    if (view == View::Composite && !p.current.rendered) {
         // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
         // CoC pass's clean-up (no NaN, no negatives, within the target's range).
         const bool srgbInput = p.current.color.depth() == CV_8U;
@@ -982,7 +986,7 @@ void Pipeline::readInto(View view, unsigned texture, bool bgra)
 {
     Impl& p = *impl_;
     CV_Assert(!p.size.empty());
-    if ((view == View::Composite && !p.rendered) || view == View::Depth || view == View::Coc) {
+    if ((view == View::Composite && !p.current.rendered) || view == View::Depth || view == View::Coc) {
         // The input as it came, or a legend drawn on the CPU: read() and uploaded. Three
         // components into RGBA8 give alpha 1; BGR bytes read as RGB put blue in red.
         const cv::Mat image = read(view, Encoding::Srgb8);
@@ -1007,10 +1011,10 @@ cv::Mat Pipeline::run(const Frame& frame, const LensSettings& lens, const Qualit
 cv::Mat Pipeline::readTarget(View view)
 {
     Impl& p = *impl_;
-    if (!p.rendered)
+    if (!p.current.rendered)
         p.render();
     // The view's nodes but the last, which would draw the view: what writes the target.
-    std::vector<Node> nodes = viewNodes(p.choices(), view, p.written);
+    std::vector<Node> nodes = viewNodes(p.choices(), view, p.current.written);
     CV_Assert(view != View::Composite && view != View::Depth && view != View::Coc && !nodes.empty());
     nodes.pop_back();
     glBindVertexArray(p.vao.id());
@@ -1072,12 +1076,12 @@ void Pipeline::finishEachPass(bool on)
 
 const SceneAnalysis& Pipeline::analysis() const
 {
-    return impl_->analysis;
+    return impl_->current.analysis;
 }
 
 const FramePlan& Pipeline::plan() const
 {
-    return impl_->plan;
+    return impl_->current.plan;
 }
 
 } // namespace defocus

@@ -11,9 +11,10 @@
 // hexagon is squeezed as the aperture is and covers its area), and the view read back. The passes
 // are the nodes of the frame graph (filter/FrameGraph.hpp) that the plan picks, run in order;
 // their images come from a pool of targets keyed by format and size, kept from frame to frame,
-// so only what a node writes is made. Each frame's own textures and measurement live in a frame
-// context, so that the next frame can be uploaded and measured (begin()) before this one's passes
-// run (finish()).
+// so only what a node writes is made. Each frame's own textures, measurement, analysis, plan and
+// the graph's progress (which targets it holds, what its nodes wrote) live in a frame context, so
+// that the next frame can be uploaded and measured (begin()) before this one's passes run
+// (finish()).
 // Needs a current GL 4.5 context (gl::EglContext) for its whole life.
 #pragma once
 
