@@ -13,24 +13,25 @@ namespace {
 
 using enum Image;
 
+using F = ImageFormat;
 constexpr std::array<ImageInfo, kImageCount> kImages{{
-    {"input colour", ImageScale::Frame, true, false},
-    {"filled depth", ImageScale::Frame, true, false},
-    {"near diameter per tile", ImageScale::Tiles, true, false},
-    {"coc", ImageScale::Blur, false, true},
-    {"bokeh sprites", ImageScale::None, false, false},
-    {"horizontal / rhombi X", ImageScale::Blur, false, true},
-    {"rhombi Z", ImageScale::Blur, false, true},
-    {"diagonal A", ImageScale::Blur, false, true},
-    {"diagonal B", ImageScale::Blur, false, true},
-    {"near horizontal", ImageScale::Blur, false, true},
-    {"near A", ImageScale::Blur, false, true},
-    {"near B", ImageScale::Blur, false, true},
-    {"half-size result", ImageScale::Blur, false, true},
-    {"half-size result, sharpened", ImageScale::Blur, false, true},
-    {"half-size result minus input", ImageScale::Blur, false, true},
-    {"output", ImageScale::Frame, false, false},
-    {"caller's texture", ImageScale::Frame, false, false},
+    {"input colour", ImageScale::Frame, F::Color, true},
+    {"filled depth", ImageScale::Frame, F::Metres, true},
+    {"near diameter per tile", ImageScale::Tiles, F::Pixels, true},
+    {"coc", ImageScale::Blur, F::Work, false},
+    {"bokeh sprites", ImageScale::None, F::Sprites, false},
+    {"horizontal / rhombi X", ImageScale::Blur, F::Work, false},
+    {"rhombi Z", ImageScale::Blur, F::Work, false},
+    {"diagonal A", ImageScale::Blur, F::Work, false},
+    {"diagonal B", ImageScale::Blur, F::Work, false},
+    {"near horizontal", ImageScale::Blur, F::Work, false},
+    {"near A", ImageScale::Blur, F::Work, false},
+    {"near B", ImageScale::Blur, F::Work, false},
+    {"half-size result", ImageScale::Blur, F::Work, false},
+    {"half-size result, sharpened", ImageScale::Blur, F::Work, false},
+    {"half-size result minus input", ImageScale::Blur, F::Work, false},
+    {"output", ImageScale::Frame, F::Output, false},
+    {"caller's texture", ImageScale::Frame, F::Rgba8, false},
 }};
 
 /// `images`, with `extra` appended where `when` holds.

@@ -50,13 +50,26 @@ enum class ImageScale : std::uint8_t {
     None   ///< a buffer
 };
 
+/// What an image holds.
+enum class ImageFormat : std::uint8_t {
+    Work,   ///< the blur targets' RGBA (rgb linear, a the signed CoC): RGBA16F or RGBA32F, by the
+            ///< frame's TargetFormat; the pipeline's pool holds these
+    Color,  ///< the frame as it went up: sRGB8 (decoded to linear on fetch) or RGB32F
+    Metres, ///< R32F metres
+    Pixels, ///< R32F, pixels of the blur
+    Sprites, ///< a storage buffer of bokeh sprites
+    Output, ///< what a read returns: sRGB8 with alpha, or RGBA32F for linear reads
+    Rgba8,  ///< a caller's RGBA8 texture
+};
+
 struct ImageInfo {
     std::string_view name; ///< the GL label of its target
     ImageScale scale;
+    ImageFormat format;
     /// Made before the graph runs (the frame's uploads), not by a node.
     bool imported;
-    /// A blur target of the pool, in the frame's work format (RGBA16F or RGBA32F).
-    bool pooled;
+    /// A target of the pipeline's pool (ImageFormat::Work).
+    bool pooled() const { return format == ImageFormat::Work; }
 };
 const ImageInfo& imageInfo(Image image);
 

@@ -643,9 +643,10 @@ Target& Pipeline::Impl::image(Image which)
 {
     Target*& held = current.images[static_cast<std::size_t>(which)];
     if (!held) {
-        assert(imageInfo(which).pooled);
+        const ImageInfo& info = imageInfo(which);
+        CV_Assert(info.pooled() && info.scale == ImageScale::Blur);
         held = &pool.take(current.quality.targetFormat == TargetFormat::Rgba16F ? GL_RGBA16F : GL_RGBA32F, blurSize,
-                          imageInfo(which).name);
+                          info.name);
     }
     return *held;
 }
@@ -665,13 +666,19 @@ const gl::Texture& Pipeline::Impl::texture(Image which, const Target* out)
 
 const gl::Framebuffer& Pipeline::Impl::drawTarget(const Node& node, const Target* out)
 {
-    const auto one = [&](Image which) -> const gl::Framebuffer& {
-        return which == Image::Output ? out->framebuffer : image(which).framebuffer;
-    };
-    if (node.writes.size() == 1)
-        return one(node.writes[0]);
-    assert(node.writes.size() == 2);
-    return pool.pair(image(node.writes[0]), image(node.writes[1]), node.name);
+    // The images drawn into: the pool's and the output, not a buffer a node fills beside them
+    // (the CoC pass's sprites, which their search writes).
+    std::array<Image, 2> drawn{};
+    std::size_t count = 0;
+    for (const Image which : node.writes)
+        if (imageInfo(which).pooled() || which == Image::Output) {
+            CV_Assert(count < drawn.size());
+            drawn[count++] = which;
+        }
+    CV_Assert(count > 0);
+    if (count == 1)
+        return drawn[0] == Image::Output ? out->framebuffer : image(drawn[0]).framebuffer;
+    return pool.pair(image(drawn[0]), image(drawn[1]), node.name);
 }
 
 void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuffer* caller, bool bgra)
@@ -1072,6 +1079,12 @@ std::vector<PassTime> Pipeline::drainGpuTimes()
 void Pipeline::finishEachPass(bool on)
 {
     impl_->timer.finishEachScope(on);
+}
+
+std::size_t Pipeline::targetsHeld() const
+{
+    const auto& images = impl_->current.images;
+    return static_cast<std::size_t>(std::count_if(images.begin(), images.end(), [](const Target* t) { return t; }));
 }
 
 const SceneAnalysis& Pipeline::analysis() const

@@ -159,6 +159,10 @@ public:
     /// (llvmpipe), where it is faster; tests and benchmarks hold the two side by side.
     void prepareOnGpu(bool on);
 
+    /// The pooled targets the last frame's nodes hold: one per image of FrameGraph's pool that
+    /// a node it ran wrote, none for an image nothing writes (tests hold it to the graph).
+    std::size_t targetsHeld() const;
+
     /// What the last frame called for, and what ran.
     const SceneAnalysis& analysis() const;
     const FramePlan& plan() const;

@@ -3,6 +3,7 @@
 // the graph its plan picks, in order, on every preset and both kernels, with and without the
 // plan's tile lists, for the composite and for a view read after it.
 #include <algorithm>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,17 @@ std::string scopes(const std::vector<PassTime>& times)
     return text;
 }
 
+/// The pooled images `nodes` write, each once.
+std::size_t pooledWrites(const std::vector<Node>& nodes)
+{
+    std::set<Image> images;
+    for (const Node& node : nodes)
+        for (const Image image : node.writes)
+            if (imageInfo(image).pooled())
+                images.insert(image);
+    return images.size();
+}
+
 GraphChoices choicesOf(const FramePlan& plan, const QualitySettings& quality)
 {
     return {quality.kernel, plan.blurShift != 0, plan.nearField, plan.highlightSprites};
@@ -39,8 +51,8 @@ GraphChoices choicesOf(const FramePlan& plan, const QualitySettings& quality)
 
 // Defects caught: a pass the pipeline runs that the graph does not list (or one it lists and the
 // pipeline skips), a pass under another name than the graph's, passes run out of the graph's
-// order, and a plan choice (near field, half size, sprites) that the pipeline follows and the
-// graph does not. The 8-bit TUM frame takes the near field and half size of the presets; the
+// order, a plan choice (near field, half size, sprites) that the pipeline follows and the graph
+// does not, and a target made for an image no node writes. The 8-bit TUM frame takes the near field and half size of the presets; the
 // corpus' float frame with lights above white takes the sprites.
 TEST_P(FrameGraphRun, TheTimerScopesAreTheGraphsNodes)
 {
@@ -71,6 +83,9 @@ TEST_P(FrameGraphRun, TheTimerScopesAreTheGraphsNodes)
             const GraphChoices choices = choicesOf(plan, quality);
             const std::vector<Node> composite = compositeFrame(choices);
             EXPECT_EQ(scopes(times), describe(composite)) << GetParam().name << ", adaptive " << adaptive;
+            // A target for each image the nodes wrote, and none for one they did not (the rhombi's
+            // A and B, which the fused composite never reads; the sprites' buffer).
+            EXPECT_EQ(pipeline.targetsHeld(), pooledWrites(composite)) << GetParam().name;
 
             // A view of diagonal B after the composite: the rhombi's second pass into A and B.
             std::vector<bool> written(kImageCount, false);
@@ -78,8 +93,11 @@ TEST_P(FrameGraphRun, TheTimerScopesAreTheGraphsNodes)
                 for (const Image image : node.writes)
                     written[static_cast<std::size_t>(image)] = true;
             pipeline.read(View::DiagonalB, Encoding::Srgb8);
-            EXPECT_EQ(scopes(pipeline.drainGpuTimes()), describe(viewNodes(choices, View::DiagonalB, written)))
-                << GetParam().name;
+            const std::vector<Node> view = viewNodes(choices, View::DiagonalB, written);
+            EXPECT_EQ(scopes(pipeline.drainGpuTimes()), describe(view)) << GetParam().name;
+            std::vector<Node> both = composite;
+            both.insert(both.end(), view.begin(), view.end());
+            EXPECT_EQ(pipeline.targetsHeld(), pooledWrites(both)) << GetParam().name;
         }
     // The presets use both; the kernels' plain settings have no near field, and McIntosh's
     // blurs no sprites.
