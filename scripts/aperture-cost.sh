@@ -20,7 +20,9 @@ width=${size%x*} height=${size#*x}
 work=$(mktemp -d "${TMPDIR:-/tmp}/aperture-cost.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 # The frames, and the lens as defocus options (max-coc: the scene's largest CoC at 640 px, scaled).
-lens=$(OPENCV_IO_ENABLE_OPENEXR=1 /usr/bin/python3 - "$scene" "$work" "$width" "$height" "$frames" <<'PY'
+# Python with the system's libraries: under scripts/gpu-figures.sh run, LD_LIBRARY_PATH puts the
+# bundle's first, and numpy fails its start-up check against them.
+lens=$(env -u LD_LIBRARY_PATH OPENCV_IO_ENABLE_OPENEXR=1 /usr/bin/python3 - "$scene" "$work" "$width" "$height" "$frames" <<'PY'
 import json, os, sys
 import cv2, numpy as np
 scene, work, width, height, frames = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5])
