@@ -209,6 +209,8 @@ struct FrameContext {
     RhombusBlurPass::Directions directions{}; ///< the rhombi's: rotated and squeezed as the aperture is
     float fallbackDepth = 1.0f;
     std::size_t frameIndex = 0;
+    /// The pipeline's number for the frame, counting begin()s: its GPU timer scopes go under it.
+    std::uint64_t serial = 0;
     FrameTimings timings;
     /// The time spent on the frame: begin()'s, then from finish() on (a frame begun ahead waits
     /// between the two, which is not its time).
@@ -314,6 +316,7 @@ struct Pipeline::Impl {
     }
 
     std::size_t gpuFrameIndex = 0; ///< frame whose GPU scopes are pending in the timer
+    std::uint64_t serials = 0;     ///< frames begun
 
     /// The frame's nodes (FrameGraph: frameNodes()), once a frame.
     void render();
@@ -439,8 +442,10 @@ std::size_t Pipeline::begun() const
 void Pipeline::dropBegun()
 {
     Impl& p = *impl_;
-    for (FrameContext& f : p.staged)
+    for (FrameContext& f : p.staged) {
+        p.timer.forget(f.serial);
         p.spareContexts.push_back(std::move(f));
+    }
     p.staged.clear();
 }
 
@@ -468,6 +473,7 @@ void Pipeline::Impl::begin(FrameContext& f, const Frame& frame, const LensSettin
     f.coefficients = scaled(lensCoc, f.gatherScale);
     f.maxCocPx = lensCoc.maxCocPx;
     f.frameIndex = frame.index;
+    f.serial = ++serials;
     f.fallbackDepth = std::isinf(lens.focusM) ? 1e6f : static_cast<float>(lens.focusM);
     f.depthPrepared = false;
     f.preparedOnCpu = false;
@@ -548,11 +554,11 @@ void Pipeline::Impl::prepare(FrameContext& f)
         f.timings.uploadMs = msSince(start);
         start = Clock::now();
         glBindVertexArray(vao.id());
-        timer.begin(DepthPrepPass::kName);
+        timer.begin(DepthPrepPass::kName, f.serial);
         depthPrepPass.run(f.hasDepth ? &f.depthAsGiven : nullptr, f.depthUnits, f.fallbackDepth,
                           lightEdges ? &f.colorTexture : nullptr, f.depth, f.depthTarget);
         timer.end();
-        timer.begin(SceneMeasurePass::kName);
+        timer.begin(SceneMeasurePass::kName, f.serial);
         f.cocParams.set(f.coefficients, f.quality.targetFormat == TargetFormat::Rgba16F);
         sceneMeasurePass.run(f.depth, srgbInput ? f.colorBytes : f.colorTexture, srgbInput, f.cocParams,
                              f.hasDepth ? &depthPrepPass.measured() : nullptr, f.measurementBuffer);
@@ -693,7 +699,7 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
     // a flat top (30) at 0 and +-120, as published.
     const float angle = RhombusBlurPass::directions(f.bladeRotationDeg).u1 + 120.0f * static_cast<float>(node.turn);
     const auto input = [&](std::size_t i) -> const gl::Texture& { return texture(node.reads[i], out); };
-    timer.begin(node.name);
+    timer.begin(node.name, f.serial);
     switch (node.pass) {
     case PassKind::Coc:
         // The bokeh sprites first: the CoC pass leaves their light out of the gather if they fit
@@ -848,7 +854,7 @@ void Pipeline::Impl::finishTimings(Clock::time_point readStart)
 {
     current.timings.readbackMs = msSince(readStart);
     current.timings.gpu.clear();
-    for (auto& [name, ms] : timer.swap())
+    for (auto& [name, ms] : timer.swap(current.serial))
         current.timings.gpu.push_back({name, ms});
     current.timings.gpuFrame = gpuFrameIndex;
     gpuFrameIndex = current.frameIndex;

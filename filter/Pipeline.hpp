@@ -101,9 +101,10 @@ public:
     /// it yet) and runs its passes, after which the reads and accessors are of it. Begun frames
     /// wait in order, each with its own textures; the reads stay of the frame finished last
     /// until the next finish(). begin(N + 1); finish() (of N) keeps the GPU busy with the
-    /// passes of N - 1 while the CPU plans N. The same output as process(). With frames begun,
-    /// the GPU timer scopes of their depth prep and measurement go with the timings of the frame
-    /// read before them. The images are referenced until the frame's passes have run.
+    /// passes of N - 1 while the CPU plans N. The same output as process(), and the same GPU
+    /// timer scopes for each frame: a frame's depth prep and measurement are timed with its own
+    /// passes, not with those of the frame read before it. The images are referenced until the
+    /// frame's passes have run.
     void begin(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
                double depthUnitsPerMetre = 0.0);
     void finish();

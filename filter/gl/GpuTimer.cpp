@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// Double-buffered GL_TIME_ELAPSED query pools.
+// GL_TIME_ELAPSED query pools, a set per frame.
 #include "filter/gl/GpuTimer.hpp"
 
 namespace defocus::gl {
@@ -24,47 +24,58 @@ GpuTimer::GpuTimer(bool enabled) : enabled_(enabled)
     glDeleteQueries(1, &id);
 }
 
-void GpuTimer::begin(std::string_view name)
+std::size_t GpuTimer::open(std::uint64_t frame)
 {
+    for (std::size_t i = 0; i < sets_.size(); ++i)
+        if (sets_[i].state == State::Open && sets_[i].frame == frame)
+            return i;
+    std::size_t i = 0;
+    while (i < sets_.size() && sets_[i].state != State::Free)
+        ++i;
+    if (i == sets_.size())
+        sets_.emplace_back();
+    sets_[i].state = State::Open;
+    sets_[i].frame = frame;
+    sets_[i].used = 0;
+    return i;
+}
+
+void GpuTimer::begin(std::string_view name, std::uint64_t frame)
+{
+    if (!enabled_ && !finish_)
+        return;
+    timing_ = open(frame);
+    Set& set = sets_[timing_];
+    if (set.used == set.scopes.size())
+        set.scopes.push_back({std::string(name), Handle<deleteQuery>(0)});
+    Scope& scope = set.scopes[set.used];
+    scope.name = name;
     if (finish_) {
         glFinish();
-        Set& set = sets_[current_];
-        if (set.used == set.scopes.size())
-            set.scopes.push_back({std::string(name), Handle<deleteQuery>(0)});
-        set.scopes[set.used].name = name;
         started_ = std::chrono::steady_clock::now();
         return;
     }
-    if (!enabled_)
-        return;
-    Set& set = sets_[current_];
-    if (set.used == set.scopes.size()) {
+    if (!scope.query) { // new, or made by a finishEachScope frame
         GLuint id = 0;
         glCreateQueries(GL_TIME_ELAPSED, 1, &id);
-        set.scopes.push_back({std::string(name), Handle<deleteQuery>(id)});
+        scope.query = Handle<deleteQuery>(id);
     }
-    if (!set.scopes[set.used].query) { // made by a finishEachScope frame
-        GLuint id = 0;
-        glCreateQueries(GL_TIME_ELAPSED, 1, &id);
-        set.scopes[set.used].query = Handle<deleteQuery>(id);
-    }
-    set.scopes[set.used].name = name;
-    set.scopes[set.used].wallMs = -1.0;
-    glBeginQuery(GL_TIME_ELAPSED, set.scopes[set.used].query.id());
+    scope.wallMs = -1.0;
+    glBeginQuery(GL_TIME_ELAPSED, scope.query.id());
 }
 
 void GpuTimer::end()
 {
     if (finish_) {
         glFinish();
-        sets_[current_].scopes[sets_[current_].used++].wallMs =
+        sets_[timing_].scopes[sets_[timing_].used++].wallMs =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started_).count();
         return;
     }
     if (!enabled_)
         return;
     glEndQuery(GL_TIME_ELAPSED);
-    ++sets_[current_].used;
+    ++sets_[timing_].used;
 }
 
 GpuTimer::Results GpuTimer::read(Set& set)
@@ -91,19 +102,43 @@ GpuTimer::Results GpuTimer::read(Set& set)
             results.emplace_back(set.scopes[i].name, static_cast<double>(ns) * 1e-6);
     }
     set.used = 0;
+    set.state = State::Free;
     return results;
 }
 
-GpuTimer::Results GpuTimer::swap()
+GpuTimer::Results GpuTimer::swap(std::uint64_t frame)
 {
-    current_ = 1 - current_;
-    return read(sets_[current_]);
+    if (!enabled_ && !finish_)
+        return {};
+    const std::size_t ending = open(frame);
+    for (Set& set : sets_)
+        if (set.state == State::Open && set.frame < frame) {
+            set.used = 0;
+            set.state = State::Free;
+        }
+    Results results;
+    if (ended_ != static_cast<std::size_t>(-1))
+        results = read(sets_[ended_]);
+    sets_[ending].state = State::Ended;
+    ended_ = ending;
+    return results;
 }
 
 GpuTimer::Results GpuTimer::drain()
 {
-    // After swap() the frame just ended is in the other set.
-    return read(sets_[1 - current_]);
+    if (ended_ == static_cast<std::size_t>(-1))
+        return {};
+    const std::size_t set = std::exchange(ended_, static_cast<std::size_t>(-1));
+    return read(sets_[set]);
+}
+
+void GpuTimer::forget(std::uint64_t frame)
+{
+    for (Set& set : sets_)
+        if (set.state == State::Open && set.frame == frame) {
+            set.used = 0;
+            set.state = State::Free;
+        }
 }
 
 } // namespace defocus::gl
