@@ -3,7 +3,8 @@
 // of field of a lens out of `src`, one frame per colour frame with its timestamp and duration,
 // each paired with the depth current at its running time (a GstVideoAggregator that runs its own
 // aggregate()). It uses only libdefocus' public API: in system memory on an EGL context of its
-// own made on the streaming thread; in GL memory (video/x-raw(memory:GLMemory)) on the pipeline's
+// own made on the streaming thread, with frames in flight (Filter::submit/receive) while colour
+// frames queue up behind each other and never one held for input that has not come; in GL memory (video/x-raw(memory:GLMemory)) on the pipeline's
 // GstGLContext, on its thread, with no frame mapped for the CPU, and where GStreamer's GL library
 // finds no display (a server with no window system) on the library's headless EGL display, which it
 // offers to its neighbours. The library's messages go to GStreamer's log (gst/LibraryLog.hpp).
@@ -19,6 +20,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -34,6 +36,25 @@ GST_DEBUG_CATEGORY_STATIC(gst_defocus_debug);
 #define GST_CAT_DEFAULT gst_defocus_debug
 
 namespace {
+
+/// A colour frame submitted to the filter and not yet received: the element's own mappings of
+/// its colour (as the colour pad prepared it) and of its depth, which the filter reads until the
+/// frame is received, and what its output buffer takes.
+struct InFlight {
+    GstVideoFrame color{}, depth{};
+    GstClockTime pts = GST_CLOCK_TIME_NONE, duration = GST_CLOCK_TIME_NONE;
+    bool post = false; ///< post-timings when it was submitted
+};
+
+void unmap(InFlight& frame)
+{
+    if (frame.color.buffer)
+        gst_video_frame_unmap(&frame.color);
+    if (frame.depth.buffer)
+        gst_video_frame_unmap(&frame.depth);
+    frame.color = {};
+    frame.depth = {};
+}
 
 /// What the element keeps besides the GObject: settings written by any thread (under `lock`),
 /// the filter and its bookkeeping used by the streaming thread only.
@@ -53,6 +74,8 @@ struct State {
     std::atomic<bool> resetPending{false}; ///< a flush happened: the next frame starts a new stream
     std::atomic<bool> depthStale{false};   ///< a flush happened: the depth frame is from before it
     GstBuffer* depthFrame = nullptr;       ///< the depth frame current at the last colour frame
+    /// Frames submitted to `filter` and not yet received, oldest first (system memory).
+    std::deque<InFlight> inFlight;
     GstClockTime depthEnd = GST_CLOCK_TIME_NONE; ///< its end, running time (NONE: no duration)
     GstClockTime lastDuration = GST_SECOND / 30; ///< the last colour frame's (a live deadline's step)
 
@@ -926,11 +949,22 @@ FrameSetup setUpFrame(GstDefocus* self, GstClockTime pts)
     return setup;
 }
 
-/// Filters `color` (the output's format) with `depth` into `outbuf`, whose PTS is set.
-GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, GstVideoFrame* depth)
+/// The frames in flight dropped: the filter's (a new stream) and the element's mappings of them.
+void dropInFlight(State& s)
+{
+    if (s.filter)
+        s.filter->reset();
+    for (InFlight& frame : s.inFlight)
+        unmap(frame);
+    s.inFlight.clear();
+}
+
+/// Submits `color` (the output's format) with `depth` to the filter, to come out with `pts`
+/// and `duration`; the frame joins the frames in flight.
+GstFlowReturn submit(GstDefocus* self, GstVideoFrame* color, GstBuffer* depth, GstVideoInfo* depthInfo,
+                     GstClockTime pts, GstClockTime duration)
 {
     State& s = *self->state;
-    const GstClockTime pts = GST_BUFFER_PTS(outbuf);
     const FrameSetup setup = setUpFrame(self, pts);
     defocus::Settings settings = setup.settings;
     // BGRx and BGRA come back as they go out, four bytes a pixel: no conversion on either side.
@@ -938,7 +972,6 @@ GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, 
     settings.output = format == GST_VIDEO_FORMAT_BGRx || format == GST_VIDEO_FORMAT_BGRA
                           ? defocus::Settings::Output::Srgb8Bgra
                           : defocus::Settings::Output::Srgb8;
-    const bool changed = setup.changed, post = setup.post;
     const defocus::gst::LibraryCall call(GST_ELEMENT(self));
 
     try {
@@ -946,7 +979,7 @@ GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, 
             // Made here, on the streaming thread, the first time a frame needs it.
             s.filter = std::make_unique<defocus::Filter>(settings);
             GST_INFO_OBJECT(self, "filtering on %s", s.filter->renderer().c_str());
-        } else if (changed || s.filter->settings().output != settings.output) {
+        } else if (setup.changed || s.filter->settings().output != settings.output) {
             s.filter->setSettings(settings);
         }
     } catch (const defocus::GlError& error) {
@@ -957,32 +990,99 @@ GstFlowReturn render(GstDefocus* self, GstBuffer* outbuf, GstVideoFrame* color, 
         return GST_FLOW_ERROR;
     }
     if (s.resetPending) {
-        s.filter->reset();
+        dropInFlight(s);
         s.resetPending = false;
     }
 
-    GstFlowReturn ret = GST_FLOW_OK;
-    GstVideoFrame out;
-    if (!gst_video_frame_map(&out, &GST_VIDEO_AGGREGATOR(self)->info, outbuf, GST_MAP_WRITE)) {
-        GST_ELEMENT_ERROR(self, RESOURCE, WRITE, ("The output buffer could not be mapped"), (nullptr));
-        ret = GST_FLOW_ERROR;
-    } else {
-        try {
-            const cv::Mat result = s.filter->process(toFilter(color), depthOf(depth), setup.seconds);
-            fromFilter(result, &out);
-            if (post)
-                postTimings(self, s.filter->lastFrame(), pts);
-        } catch (const defocus::Error& error) {
-            GST_ELEMENT_ERROR(self, STREAM, FORMAT, ("%s", error.what()), (nullptr));
-            ret = GST_FLOW_ERROR;
-        } catch (const cv::Exception& error) {
-            GST_ELEMENT_ERROR(self, STREAM, FAILED, ("%s", error.what()), (nullptr));
-            ret = GST_FLOW_ERROR;
-        }
-        gst_video_frame_unmap(&out);
+    // The element's own mappings: the colour pad's is cleaned when this returns, and the depth
+    // frame may be replaced before the frame is received.
+    InFlight frame;
+    frame.pts = pts;
+    frame.duration = duration;
+    frame.post = setup.post;
+    if (!gst_video_frame_map(&frame.color, &color->info, color->buffer, GST_MAP_READ) ||
+        !gst_video_frame_map(&frame.depth, depthInfo, depth, GST_MAP_READ)) {
+        unmap(frame);
+        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("A colour or depth frame could not be mapped"), (nullptr));
+        return GST_FLOW_ERROR;
     }
+    try {
+        s.filter->submit(toFilter(&frame.color), depthOf(&frame.depth), setup.seconds);
+    } catch (const defocus::Error& error) {
+        unmap(frame);
+        GST_ELEMENT_ERROR(self, STREAM, FORMAT, ("%s", error.what()), (nullptr));
+        return GST_FLOW_ERROR;
+    } catch (const cv::Exception& error) {
+        unmap(frame);
+        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("%s", error.what()), (nullptr));
+        return GST_FLOW_ERROR;
+    }
+    s.inFlight.push_back(frame);
+    return GST_FLOW_OK;
+}
+
+/// Receives the oldest frame in flight from the filter and pushes it downstream with its
+/// timestamp and duration.
+GstFlowReturn pushOldest(GstDefocus* self)
+{
+    State& s = *self->state;
+    auto* agg = GST_AGGREGATOR(self);
+    auto* vagg = GST_VIDEO_AGGREGATOR(self);
+    InFlight frame = s.inFlight.front();
+    s.inFlight.pop_front();
+    cv::Mat result;
+    try {
+        const defocus::gst::LibraryCall call(GST_ELEMENT(self));
+        result = s.filter->receive().value();
+        if (frame.post)
+            postTimings(self, s.filter->lastFrame(), frame.pts);
+    } catch (const defocus::Error& error) {
+        unmap(frame);
+        GST_ELEMENT_ERROR(self, STREAM, FORMAT, ("%s", error.what()), (nullptr));
+        return GST_FLOW_ERROR;
+    } catch (const cv::Exception& error) {
+        unmap(frame);
+        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("%s", error.what()), (nullptr));
+        return GST_FLOW_ERROR;
+    }
+    unmap(frame);
+
+    GstBuffer* outbuf = nullptr;
+    GstFlowReturn ret = GST_VIDEO_AGGREGATOR_CLASS(gst_defocus_parent_class)->create_output_buffer(vagg, &outbuf);
+    if (ret != GST_FLOW_OK || !outbuf)
+        return ret;
+    GST_BUFFER_PTS(outbuf) = frame.pts;
+    GST_BUFFER_DTS(outbuf) = GST_CLOCK_TIME_NONE;
+    GST_BUFFER_DURATION(outbuf) = frame.duration;
+    GstVideoFrame out;
+    if (!gst_video_frame_map(&out, &vagg->info, outbuf, GST_MAP_WRITE)) {
+        gst_buffer_unref(outbuf);
+        GST_ELEMENT_ERROR(self, RESOURCE, WRITE, ("The output buffer could not be mapped"), (nullptr));
+        return GST_FLOW_ERROR;
+    }
+    fromFilter(result, &out);
+    gst_video_frame_unmap(&out);
+    return gst_aggregator_finish_buffer(agg, outbuf);
+}
+
+/// Pushes the frames in flight out: all of them, or (`all` false) the oldest until fewer than
+/// the filter's kFramesInFlight are left.
+GstFlowReturn pushReceived(GstDefocus* self, bool all)
+{
+    State& s = *self->state;
+    if (s.resetPending) { // a flush: frames from before it are not pushed
+        dropInFlight(s);
+        s.resetPending = false;
+    }
+    GstFlowReturn ret = GST_FLOW_OK;
+    while (ret == GST_FLOW_OK && !s.inFlight.empty() &&
+           (all || s.inFlight.size() >= defocus::Filter::kFramesInFlight))
+        ret = pushOldest(self);
+    if (!s.inFlight.empty())
+        GST_LOG_OBJECT(self, "%zu frame(s) in flight", s.inFlight.size());
     // The streaming thread may be another one after a seek or a pause: let it take the context.
-    s.filter->release();
+    if (s.filter)
+        s.filter->release();
     return ret;
 }
 
@@ -1174,11 +1274,15 @@ GstFlowReturn aggregate(GstAggregator* agg, gboolean timeout)
 
     GstBuffer* colorBuffer = gst_aggregator_pad_peek_buffer(color);
     if (!colorBuffer) {
-        // The colour has ended (depth may go on, e.g. from imagefreeze): so has the output.
+        // The colour has ended (depth may go on, e.g. from imagefreeze): so has the output,
+        // after the frames still in flight.
         const bool ended = gst_aggregator_pad_is_eos(color);
         if (!ended && timeout)
             advance(agg, s.lastDuration);
         unrefPads();
+        const GstFlowReturn pushed = pushReceived(self, true);
+        if (pushed != GST_FLOW_OK)
+            return pushed;
         return ended ? GST_FLOW_EOS : GST_AGGREGATOR_FLOW_NEED_DATA;
     }
     if (GST_VIDEO_INFO_FORMAT(&vagg->info) == GST_VIDEO_FORMAT_UNKNOWN) {
@@ -1189,9 +1293,11 @@ GstFlowReturn aggregate(GstAggregator* agg, gboolean timeout)
     const GstClockTime colorTime = runningTimeOf(color, colorBuffer);
     const GstClockTime duration = durationOf(vagg, colorBuffer);
     if (!catchUpDepth(s, depth, colorTime) && !timeout) {
+        // Waiting for this frame's depth: the frames in flight go out meanwhile.
         gst_buffer_unref(colorBuffer);
         unrefPads();
-        return GST_AGGREGATOR_FLOW_NEED_DATA;
+        const GstFlowReturn pushed = pushReceived(self, true);
+        return pushed != GST_FLOW_OK ? pushed : GST_AGGREGATOR_FLOW_NEED_DATA;
     }
     if (!s.depthFrame && gst_aggregator_pad_is_eos(depth)) {
         GST_ELEMENT_ERROR(self, STREAM, FAILED, ("The depth stream ended before its first frame"), (nullptr));
@@ -1213,38 +1319,43 @@ GstFlowReturn aggregate(GstAggregator* agg, gboolean timeout)
         s.lastDuration = duration;
 
     GstFlowReturn ret = GST_FLOW_OK;
-    GstBuffer* outbuf = nullptr;
+    GstBuffer* outbuf = nullptr; // the GL path's
+    GST_OBJECT_LOCK(self);
+    GstVideoInfo depthInfo = depthPad->info;
+    GstVideoInfo colorInfo = colorPad->info;
+    GST_OBJECT_UNLOCK(self);
     if (!s.depthFrame) {
         // Live: no depth yet by this colour frame's deadline; it is dropped, not waited for.
         GST_DEBUG_OBJECT(self, "no depth by %" GST_TIME_FORMAT ": colour frame dropped", GST_TIME_ARGS(colorTime));
-    } else if ((ret = GST_VIDEO_AGGREGATOR_CLASS(gst_defocus_parent_class)->create_output_buffer(vagg, &outbuf)) ==
-                   GST_FLOW_OK &&
-               outbuf) {
-        GST_BUFFER_PTS(outbuf) = pts;
-        GST_BUFFER_DTS(outbuf) = GST_CLOCK_TIME_NONE;
-        GST_BUFFER_DURATION(outbuf) = duration;
-        // The colour in the output's format (the colour pad converts it), the depth as it came.
-        auto* colorClass = GST_VIDEO_AGGREGATOR_PAD_GET_CLASS(colorPad);
-        GstVideoFrame prepared{}, depthFrame{};
-        GST_OBJECT_LOCK(self);
-        GstVideoInfo depthInfo = depthPad->info;
-        GstVideoInfo colorInfo = colorPad->info;
-        GST_OBJECT_UNLOCK(self);
-        if (s.glOutput) {
+    } else if (s.glOutput) {
+        // GL memory, one frame at a time on the pipeline's context; any frames still in flight
+        // from system memory (caps renegotiated) go out first.
+        ret = pushReceived(self, true);
+        if (ret == GST_FLOW_OK &&
+            (ret = GST_VIDEO_AGGREGATOR_CLASS(gst_defocus_parent_class)->create_output_buffer(vagg, &outbuf)) ==
+                GST_FLOW_OK &&
+            outbuf) {
+            GST_BUFFER_PTS(outbuf) = pts;
+            GST_BUFFER_DTS(outbuf) = GST_CLOCK_TIME_NONE;
+            GST_BUFFER_DURATION(outbuf) = duration;
             ret = renderGl(self, outbuf, colorBuffer, &colorInfo, s.depthFrame, &depthInfo);
-        } else {
-        const bool colorMapped = colorClass->prepare_frame(colorPad, vagg, colorBuffer, &prepared) && prepared.buffer;
-        const bool depthMapped = gst_video_frame_map(&depthFrame, &depthInfo, s.depthFrame, GST_MAP_READ);
-        if (!colorMapped || !depthMapped) {
+        }
+    } else {
+        // The colour in the output's format (the colour pad converts it), the depth as it came,
+        // submitted; the oldest frame in flight comes out when the filter holds its
+        // kFramesInFlight, and every one when no colour frame waits behind this one (a frame is
+        // never held for input that is not there: no latency added).
+        auto* colorClass = GST_VIDEO_AGGREGATOR_PAD_GET_CLASS(colorPad);
+        GstVideoFrame prepared{};
+        if (!colorClass->prepare_frame(colorPad, vagg, colorBuffer, &prepared) || !prepared.buffer) {
             GST_ELEMENT_ERROR(self, STREAM, FAILED, ("A colour or depth frame could not be mapped"), (nullptr));
             ret = GST_FLOW_ERROR;
         } else {
-            ret = render(self, outbuf, &prepared, &depthFrame);
+            ret = submit(self, &prepared, s.depthFrame, &depthInfo, pts, duration);
         }
-        if (depthMapped)
-            gst_video_frame_unmap(&depthFrame);
         colorClass->clean_frame(colorPad, vagg, &prepared);
-        }
+        if (ret == GST_FLOW_OK)
+            ret = pushReceived(self, !gst_aggregator_pad_has_buffer(color));
     }
     gst_buffer_unref(colorBuffer);
     unrefPads();
@@ -1273,6 +1384,7 @@ gboolean stop(GstAggregator* agg)
 {
     State& s = stateOf(agg);
     // The streaming task has stopped and released the context: it can be made current here.
+    dropInFlight(s);
     s.filter.reset();
     dropGl(s);
     s.warned.clear();
@@ -1289,6 +1401,8 @@ gboolean stop(GstAggregator* agg)
 void finalize(GObject* object)
 {
     State& s = *GST_DEFOCUS(object)->state;
+    for (InFlight& frame : s.inFlight)
+        unmap(frame);
     gst_clear_buffer(&s.depthFrame);
     dropGl(s);
     gst_clear_object(&s.otherContext);
