@@ -15,23 +15,25 @@ using enum Image;
 
 using F = ImageFormat;
 constexpr std::array<ImageInfo, kImageCount> kImages{{
-    {"input colour", ImageScale::Frame, F::Color, true},
-    {"filled depth", ImageScale::Frame, F::Metres, true},
-    {"near diameter per tile", ImageScale::Tiles, F::Pixels, true},
-    {"coc", ImageScale::Blur, F::Work, false},
-    {"bokeh sprites", ImageScale::None, F::Sprites, false},
-    {"horizontal / rhombi X", ImageScale::Blur, F::Work, false},
-    {"rhombi Z", ImageScale::Blur, F::Work, false},
-    {"diagonal A", ImageScale::Blur, F::Work, false},
-    {"diagonal B", ImageScale::Blur, F::Work, false},
-    {"near horizontal", ImageScale::Blur, F::Work, false},
-    {"near A", ImageScale::Blur, F::Work, false},
-    {"near B", ImageScale::Blur, F::Work, false},
-    {"half-size result", ImageScale::Blur, F::Work, false},
-    {"half-size result, sharpened", ImageScale::Blur, F::Work, false},
-    {"half-size result minus input", ImageScale::Blur, F::Work, false},
-    {"output", ImageScale::Frame, F::Output, false},
-    {"caller's texture", ImageScale::Frame, F::Rgba8, false},
+    {"input colour", ImageScale::Frame, F::Color},
+    {"depth as given", ImageScale::Given, F::Given},
+    {"filled depth", ImageScale::Frame, F::Metres},
+    {"scene measurement", ImageScale::None, F::Measurement},
+    {"near diameter per tile", ImageScale::Tiles, F::Pixels},
+    {"coc", ImageScale::Blur, F::Work},
+    {"bokeh sprites", ImageScale::None, F::Sprites},
+    {"horizontal / rhombi X", ImageScale::Blur, F::Work},
+    {"rhombi Z", ImageScale::Blur, F::Work},
+    {"diagonal A", ImageScale::Blur, F::Work},
+    {"diagonal B", ImageScale::Blur, F::Work},
+    {"near horizontal", ImageScale::Blur, F::Work},
+    {"near A", ImageScale::Blur, F::Work},
+    {"near B", ImageScale::Blur, F::Work},
+    {"half-size result", ImageScale::Blur, F::Work},
+    {"half-size result, sharpened", ImageScale::Blur, F::Work},
+    {"half-size result minus input", ImageScale::Blur, F::Work},
+    {"output", ImageScale::Frame, F::Output},
+    {"caller's texture", ImageScale::Frame, F::Rgba8},
 }};
 
 /// `images`, with `extra` appended where `when` holds.
@@ -54,6 +56,19 @@ bool isWritten(const std::vector<bool>& written, Image image)
 const ImageInfo& imageInfo(Image image)
 {
     return kImages[static_cast<std::size_t>(image)];
+}
+
+std::vector<Image> frameImports(bool depthPrepOnGpu)
+{
+    return {Color, depthPrepOnGpu ? DepthAsGiven : Depth, NearDiameter};
+}
+
+std::vector<Node> prepareNodes(bool depthPrepOnGpu, bool lightEdges)
+{
+    if (!depthPrepOnGpu)
+        return {};
+    return {{PassKind::DepthPrep, "depth-prep", with({DepthAsGiven}, lightEdges, Color), {Depth}},
+            {PassKind::SceneMeasure, "scene-measure", {Depth, Color}, {Measurement}}};
 }
 
 std::vector<Node> frameNodes(const GraphChoices& c)
@@ -145,11 +160,11 @@ std::vector<Node> compositeFrame(const GraphChoices& choices)
     return nodes;
 }
 
-std::string graphError(const std::vector<Node>& nodes, bool everyWriteRead)
+std::string graphError(const std::vector<Node>& nodes, bool everyWriteRead, const std::vector<Image>& imports)
 {
-    std::vector<bool> written(kImageCount, false);
-    for (int i = 0; i < kImageCount; ++i)
-        written[static_cast<std::size_t>(i)] = imageInfo(static_cast<Image>(i)).imported;
+    std::vector<bool> written(kImageCount, false), imported(kImageCount, false);
+    for (const Image image : imports)
+        written[static_cast<std::size_t>(image)] = imported[static_cast<std::size_t>(image)] = true;
     std::set<std::string_view> names;
     for (std::size_t n = 0; n < nodes.size(); ++n) {
         const Node& node = nodes[n];
@@ -160,7 +175,7 @@ std::string graphError(const std::vector<Node>& nodes, bool everyWriteRead)
                 return fmt::format("node {} ({}) reads {} before any node wrote it", n, node.name,
                                    imageInfo(image).name);
         for (const Image image : node.writes) {
-            if (imageInfo(image).imported)
+            if (imported[static_cast<std::size_t>(image)])
                 return fmt::format("node {} ({}) writes {}, which the frame imports", n, node.name,
                                    imageInfo(image).name);
             written[static_cast<std::size_t>(image)] = true;
@@ -168,7 +183,7 @@ std::string graphError(const std::vector<Node>& nodes, bool everyWriteRead)
         if (!everyWriteRead)
             continue;
         for (const Image image : node.writes) {
-            if (image == Output || image == CallerTexture)
+            if (image == Output || image == CallerTexture || image == Measurement)
                 continue;
             bool read = false;
             for (std::size_t later = n + 1; later < nodes.size() && !read; ++later)

@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The passes of a frame, declared before any of them runs: an ordered list of nodes, each with
 // its name (the GPU timer scope, the GL label, the rows of --timing), the images it reads and the
-// images it writes. The frame plan picks the list (the rhombi or McIntosh's blurs, full or half
+// images it writes. Depth preparation and the scene measurement come first (on the GPU; where
+// they run on the CPU the filled depth is uploaded instead); the frame plan, made from the
+// measurement, then picks the list (the rhombi or McIntosh's blurs, full or half
 // size, the near field, the bokeh sprites); a view adds the nodes that make it from what the
 // frame's nodes wrote. Pipeline runs the nodes in order and takes each image a node writes from
 // a pool of targets keyed by format and size, so an image nobody's list names is never made.
-// The graph is data: tests hold it valid (every image a node reads is the frame's own or written
-// by an earlier node; on the composite, every image written is read) without a GL context.
+// The graph is data: tests hold it valid (every image a node reads is one the frame imports or
+// written by an earlier node; on the composite, every image written is read) without a GL context.
 #pragma once
 
 #include <cstdint>
@@ -23,7 +25,9 @@ namespace defocus {
 /// The images (and one buffer) the passes of a frame read and write.
 enum class Image : std::uint8_t {
     Color,          ///< the frame's colour, linear (imported: uploaded before the graph runs)
-    Depth,          ///< the frame's filled depth (imported)
+    DepthAsGiven,   ///< the frame's depth as it came (imported where depth prep runs on the GPU)
+    Depth,          ///< the frame's filled depth, the frame's size (depth prep's, or imported)
+    Measurement,    ///< the scene measurement, a buffer the CPU reads back to plan the frame
     NearDiameter,   ///< the near field's diameter per tile (imported: uploaded from the analysis)
     Coc,            ///< colour and signed CoC at the blur size (View::Input)
     Sprites,        ///< the bokeh sprites found for the lights (a buffer)
@@ -47,6 +51,7 @@ enum class ImageScale : std::uint8_t {
     Frame, ///< the frame's pixels
     Blur,  ///< the blur passes' pixels: the frame's, or half of them (FramePlan::blurShift)
     Tiles, ///< one texel per analysis tile
+    Given, ///< the source's own (the depth, resized by depth prep)
     None   ///< a buffer
 };
 
@@ -55,7 +60,9 @@ enum class ImageFormat : std::uint8_t {
     Work,   ///< the blur targets' RGBA (rgb linear, a the signed CoC): RGBA16F or RGBA32F, by the
             ///< frame's TargetFormat; the pipeline's pool holds these
     Color,  ///< the frame as it went up: sRGB8 (decoded to linear on fetch) or RGB32F
+    Given,  ///< the depth as it came: R16UI in its units, or R32F metres
     Metres, ///< R32F metres
+    Measurement, ///< SceneMeasurePass's storage buffer
     Pixels, ///< R32F, pixels of the blur
     Sprites, ///< a storage buffer of bokeh sprites
     Output, ///< what a read returns: sRGB8 with alpha, or RGBA32F for linear reads
@@ -66,8 +73,6 @@ struct ImageInfo {
     std::string_view name; ///< the GL label of its target
     ImageScale scale;
     ImageFormat format;
-    /// Made before the graph runs (the frame's uploads), not by a node.
-    bool imported;
     /// A target of the pipeline's pool (ImageFormat::Work).
     bool pooled() const { return format == ImageFormat::Work; }
 };
@@ -75,6 +80,8 @@ const ImageInfo& imageInfo(Image image);
 
 /// What a node runs; Pipeline has one way to run each.
 enum class PassKind : std::uint8_t {
+    DepthPrep,        ///< the depth resized to the frame and its holes filled
+    SceneMeasure,     ///< the valid depths' range, the tiles' CoC ranges, the highlights
     Coc,              ///< the CoC pass, the bokeh sprites found first when the plan has them
     RhombiLines,      ///< rhombi pass 1: the lines X and Z
     RhombiDiagonals,  ///< rhombi pass 2 into A and B
@@ -111,6 +118,16 @@ struct GraphChoices {
     bool sprites = false;    ///< FramePlan::highlightSprites
 };
 
+/// The images a frame has before any node runs (its uploads): the colour, the near field's
+/// diameters (uploaded when the frame is planned), and the depth as it came where depth prep
+/// runs on the GPU (`depthPrepOnGpu`), the filled depth where it ran on the CPU.
+std::vector<Image> frameImports(bool depthPrepOnGpu);
+
+/// The nodes that prepare a frame for its plan, before the frame's nodes: depth prep and the
+/// scene measurement on the GPU (`lightEdges`: depth prep reads the colour to put the lights'
+/// edges at their lights' depth); none where they run on the CPU.
+std::vector<Node> prepareNodes(bool depthPrepOnGpu, bool lightEdges);
+
 /// The nodes every frame that is not all in focus runs, whatever is read: the CoC and the blurs
 /// as far as they go without knowing the view.
 std::vector<Node> frameNodes(const GraphChoices& choices);
@@ -132,10 +149,11 @@ std::vector<Node> compositeFrame(const GraphChoices& choices);
 /// composite).
 Image viewedImage(View view);
 
-/// Why `nodes` (a frame's list, imports first made) is not a valid frame: an image read before
-/// any node wrote it, a name given twice, or (`everyWriteRead`) an image written that no later
-/// node reads and that is not the output. Empty when valid.
-std::string graphError(const std::vector<Node>& nodes, bool everyWriteRead);
+/// Why `nodes` (a frame's list, after `imports` were made) is not a valid frame: an image read
+/// before any node wrote it, an import written, a name given twice, or (`everyWriteRead`) an
+/// image written that no later node reads and that is not the output or the measurement (which
+/// the CPU reads). Empty when valid.
+std::string graphError(const std::vector<Node>& nodes, bool everyWriteRead, const std::vector<Image>& imports);
 
 /// "coc > rhombi-1 > rhombi-2 > ..." for logs and --explain.
 std::string describe(const std::vector<Node>& nodes);

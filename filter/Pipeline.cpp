@@ -554,15 +554,22 @@ void Pipeline::Impl::prepare(FrameContext& f)
         f.timings.uploadMs = msSince(start);
         start = Clock::now();
         glBindVertexArray(vao.id());
-        timer.begin(DepthPrepPass::kName, f.serial);
-        depthPrepPass.run(f.hasDepth ? &f.depthAsGiven : nullptr, f.depthUnits, f.fallbackDepth,
-                          lightEdges ? &f.colorTexture : nullptr, f.depth, f.depthTarget);
-        timer.end();
-        timer.begin(SceneMeasurePass::kName, f.serial);
-        f.cocParams.set(f.coefficients, f.quality.targetFormat == TargetFormat::Rgba16F);
-        sceneMeasurePass.run(f.depth, srgbInput ? f.colorBytes : f.colorTexture, srgbInput, f.cocParams,
-                             f.hasDepth ? &depthPrepPass.measured() : nullptr, f.measurementBuffer);
-        timer.end();
+        for (const Node& node : prepareNodes(true, lightEdges)) {
+            timer.begin(node.name, f.serial);
+            switch (node.pass) {
+            case PassKind::DepthPrep:
+                depthPrepPass.run(f.hasDepth ? &f.depthAsGiven : nullptr, f.depthUnits, f.fallbackDepth,
+                                  lightEdges ? &f.colorTexture : nullptr, f.depth, f.depthTarget);
+                break;
+            case PassKind::SceneMeasure:
+                f.cocParams.set(f.coefficients, f.quality.targetFormat == TargetFormat::Rgba16F);
+                sceneMeasurePass.run(f.depth, srgbInput ? f.colorBytes : f.colorTexture, srgbInput, f.cocParams,
+                                     f.hasDepth ? &depthPrepPass.measured() : nullptr, f.measurementBuffer);
+                break;
+            default: CV_Error(cv::Error::StsInternal, std::string(node.name) + " is not a pass that prepares a frame");
+            }
+            timer.end();
+        }
         f.timings.depthPrepMs = msSince(start);
         f.measuring = true;
     } else {
@@ -776,6 +783,9 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
     case PassKind::OutputCopy:
         outputCopyPass.run(out->texture, out->generation, *caller, bgra);
         break;
+    case PassKind::DepthPrep:
+    case PassKind::SceneMeasure:
+        CV_Error(cv::Error::StsInternal, std::string(node.name) + " runs when a frame is begun (prepare())");
     }
     timer.end();
     for (const Image image : node.writes)

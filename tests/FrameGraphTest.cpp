@@ -45,23 +45,28 @@ std::vector<Node> concat(std::vector<Node> first, const std::vector<Node>& secon
 }
 
 // Catches a node that reads an image no earlier node wrote (a view that runs before the pass
-// that makes its input, a list that forgets a pass) and, on the composite, a target written and
-// never read (work the frame pays for and nobody sees).
+// that makes its input, a list that forgets a pass, depth prep on the GPU left out) and, on the
+// composite, a target written and never read (work the frame pays for and nobody sees); with
+// depth prep on the GPU and on the CPU, the lights' edges put at their depth or not.
 TEST(FrameGraph, EveryListIsAValidFrame)
 {
     const View views[] = {View::Composite, View::Input, View::Horizontal, View::DiagonalA,
                           View::DiagonalB, View::Depth, View::Coc};
-    for (const GraphChoices& c : everyChoice()) {
-        const std::vector<Node> frame = frameNodes(c);
-        for (const View view : views)
-            for (bool toCaller : {false, true}) {
-                const std::vector<Node> nodes = concat(frame, viewNodes(c, view, writtenBy(frame), toCaller));
-                // Views other than the composite show one image of the frame's and leave the rest.
-                EXPECT_EQ(graphError(nodes, view == View::Composite), "")
-                    << label(c) << ", view " << static_cast<int>(view) << ": " << describe(nodes);
-                EXPECT_EQ(nodes.back().writes.back(), toCaller ? Image::CallerTexture : Image::Output) << label(c);
+    for (const bool onGpu : {true, false})
+        for (const bool lightEdges : {true, false})
+            for (const GraphChoices& c : everyChoice()) {
+                const std::vector<Node> frame = concat(prepareNodes(onGpu, lightEdges), frameNodes(c));
+                for (const View view : views)
+                    for (bool toCaller : {false, true}) {
+                        const std::vector<Node> nodes = concat(frame, viewNodes(c, view, writtenBy(frame), toCaller));
+                        // Views other than the composite show one image of the frame's and leave the rest.
+                        EXPECT_EQ(graphError(nodes, view == View::Composite, frameImports(onGpu)), "")
+                            << label(c) << (onGpu ? ", GPU" : ", CPU") << " depth prep, view " << static_cast<int>(view)
+                            << ": " << describe(nodes);
+                        EXPECT_EQ(nodes.back().writes.back(), toCaller ? Image::CallerTexture : Image::Output)
+                            << label(c);
+                    }
             }
-    }
 }
 
 // Catches a view read after another that runs the rhombi's second pass twice or skips it: after
@@ -75,7 +80,8 @@ TEST(FrameGraph, LaterViewsReuseWhatEarlierViewsWrote)
         const std::vector<Node> second = viewNodes(c, View::DiagonalB, writtenBy(nodes));
         EXPECT_EQ(second.size(), 1u) << label(c) << ": " << describe(second);
         EXPECT_EQ(composite.front().pass, PassKind::Composite) << label(c) << ": " << describe(composite);
-        EXPECT_EQ(graphError(concat(nodes, composite), false), "") << label(c) << ": " << describe(composite);
+        EXPECT_EQ(graphError(concat(nodes, composite), false, frameImports(false)), "")
+            << label(c) << ": " << describe(composite);
     }
 }
 
@@ -89,15 +95,34 @@ TEST(FrameGraph, TheCheckRefusesAnInvalidFrame)
     for (std::size_t i = 0; i + 1 < swapped.size(); ++i)
         if (swapped[i].pass == PassKind::Prefilter)
             std::swap(swapped[i], swapped[i + 1]);
-    EXPECT_NE(graphError(swapped, false).find("reads"), std::string::npos) << describe(swapped);
+    const std::vector<Image> imports = frameImports(false);
+    EXPECT_NE(graphError(swapped, false, imports).find("reads"), std::string::npos) << describe(swapped);
     // A pass whose image nothing reads.
     std::vector<Node> unread = nodes;
     unread.insert(unread.begin() + 1, Node{PassKind::McIntoshBlur, "horizontal", {Image::Coc}, {Image::DiagonalA}});
-    EXPECT_NE(graphError(unread, true).find("no later node reads"), std::string::npos) << describe(unread);
+    EXPECT_NE(graphError(unread, true, imports).find("no later node reads"), std::string::npos) << describe(unread);
     // Two scopes of one name.
     std::vector<Node> twice = nodes;
     twice.push_back(nodes.front());
-    EXPECT_NE(graphError(twice, false).find("second node"), std::string::npos);
+    EXPECT_NE(graphError(twice, false, imports).find("second node"), std::string::npos);
+    // The frame's nodes where depth prep runs on the GPU and the list leaves it out: the depth
+    // the CoC pass reads was never filled.
+    EXPECT_NE(graphError(nodes, false, frameImports(true)).find("reads filled depth"), std::string::npos);
+    // A pass that draws over the frame's colour, which later passes read as it came.
+    std::vector<Node> overwrite = nodes;
+    overwrite.insert(overwrite.begin() + 1, Node{PassKind::Prefilter, "paint", {Image::Coc}, {Image::Color}});
+    EXPECT_NE(graphError(overwrite, false, imports).find("which the frame imports"), std::string::npos);
+}
+
+// Catches depth prep and the measurement listed where they run on the CPU, or not where on the
+// GPU, and depth prep not reading the colour it puts the lights' edges from.
+TEST(FrameGraph, DepthPrepIsANodeWhereItRunsOnTheGpu)
+{
+    EXPECT_EQ(describe(prepareNodes(true, true)), "depth-prep > scene-measure");
+    EXPECT_EQ(describe(prepareNodes(false, true)), "");
+    const std::vector<Node> withEdges = prepareNodes(true, true), without = prepareNodes(true, false);
+    EXPECT_EQ(withEdges.front().reads, (std::vector<Image>{Image::DepthAsGiven, Image::Color}));
+    EXPECT_EQ(without.front().reads, std::vector<Image>{Image::DepthAsGiven});
 }
 
 // Catches a plan choice that does not reach the graph: each choice changes the passes run.
