@@ -325,10 +325,12 @@ TEST_F(HighlightSprites, ALightInFrontOfABlurredBackgroundIsNotDrawnASecondTimeB
             std::printf("[ FIGURE   ] %s, %s: %.3f of the light outside its reach\n", c.name, preset.name.c_str(),
                         stray);
             // The second hexagon held 52-70 % of the light in focus and 18 % with the edge at the
-            // background's depth. Below a tenth: the rule keeps white's worth of such a light in
-            // the gather (a faint halo, as for any colour up to white), and the bilinear taps at
-            // its edge mix a share of it with the background's CoC (up to 4.3 % in focus).
-            EXPECT_LT(stray, 0.1) << c.name << ", " << preset.name;
+            // background's depth. The gather keeps white's worth of a light that makes sprites;
+            // while the rule hid only taps above white, that white's worth still lit the
+            // background as far as its blur reached: 1.5-2.6 % of the light outside its reach
+            // for the blurred light and its antialiased edge. Hidden, 0.1-0.3 % is left: the
+            // bilinear taps at the light's edge mix a share of it with the background's CoC.
+            EXPECT_LT(stray, 0.008) << c.name << ", " << preset.name;
             // In focus: a tap above white that its own blur does not bring here is hidden, not
             // lit (counted as white's worth instead, it left 7.4-7.6 % of the light outside its
             // reach, 3.3 % at full size), and the light enters the blur as what lies round it
