@@ -390,6 +390,47 @@ TEST_F(GstDefocus, FlushThenStreamAgain)
     EXPECT_TRUE(identical(matOf(out, other.bgr.size(), CV_8UC3), library(lensSettings(), other.bgr, other.depth16)));
 }
 
+// Defect caught: a flushing seek that does not start a new stream in the filter (its reset
+// skipped, or made for one path and not the other), so that the autofocus of the frames after the
+// seek goes on from where the frames before it left it. With a slow autofocus (10 s) a frame whose
+// centre lies twice as far as the frame before the flush is focused where a fresh filter focuses
+// it, byte for byte, only if the seek reset the filter.
+TEST_F(GstDefocus, FlushStartsANewStreamForTheAutofocus)
+{
+    Element e({"autofocus=true", "autofocus-time-constant=10", "f-number=1.4", "depth-scale=5000"});
+    e.setCaps("BGR", frame_.bgr.size(), "GRAY16_LE", frame_.depth16.size(), "BGR");
+    ASSERT_EQ(gst_harness_push(e.color, bufferOf(frame_.bgr, 0)), GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(e.depth, bufferOf(frame_.depth16, 0)), GST_FLOW_OK);
+    gst_buffer_unref(gst_harness_pull(e.color));
+    const guint32 seqnum = gst_util_seqnum_next();
+    for (GstHarness* h : {e.color, e.depth}) {
+        GstEvent* start = gst_event_new_flush_start();
+        GstEvent* stop = gst_event_new_flush_stop(TRUE);
+        gst_event_set_seqnum(start, seqnum);
+        gst_event_set_seqnum(stop, seqnum);
+        ASSERT_TRUE(gst_harness_push_event(h, start));
+        ASSERT_TRUE(gst_harness_push_event(h, stop));
+        GstSegment segment;
+        gst_segment_init(&segment, GST_FORMAT_TIME);
+        ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_segment(&segment)));
+    }
+    const cv::Mat farther = frame_.depth16 * 2;
+    ASSERT_EQ(gst_harness_push(e.color, bufferOf(frame_.bgr, 0)), GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(e.depth, bufferOf(farther, 0)), GST_FLOW_OK);
+    GstBuffer* out = nullptr;
+    while ((out = gst_harness_pull(e.color)) && GST_BUFFER_PTS(out) != 0)
+        gst_buffer_unref(out);
+    ASSERT_NE(out, nullptr);
+    defocus::Settings settings = lensSettings();
+    settings.autofocus.mode = defocus::AutofocusOptions::Mode::Follow;
+    settings.autofocus.timeConstantS = 10.0;
+    const cv::Mat fresh = library(settings, frame_.bgr, farther);
+    defocus::Filter continued(settings);
+    continued.process(frame_.bgr, frame_.depth16);
+    ASSERT_FALSE(identical(fresh, continued.process(frame_.bgr, farther))) << "the two focus the same";
+    EXPECT_TRUE(identical(matOf(out, frame_.bgr.size(), CV_8UC3), fresh));
+}
+
 // Defect caught: caps the element cannot use accepted (8-bit depth read as 16-bit).
 TEST_F(GstDefocus, RefusesDepthThatIsNotSixteenBit)
 {
