@@ -959,6 +959,23 @@ void dropInFlight(State& s)
     s.inFlight.clear();
 }
 
+/// Runs `call`, a call of the filter for `frame`; an error of the library or of OpenCV becomes
+/// the element's, and the frame's mappings are let go.
+template <typename Call>
+GstFlowReturn guarded(GstDefocus* self, InFlight& frame, Call&& call)
+{
+    try {
+        call();
+        return GST_FLOW_OK;
+    } catch (const defocus::Error& error) {
+        GST_ELEMENT_ERROR(self, STREAM, FORMAT, ("%s", error.what()), (nullptr));
+    } catch (const cv::Exception& error) {
+        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("%s", error.what()), (nullptr));
+    }
+    unmap(frame);
+    return GST_FLOW_ERROR;
+}
+
 /// Submits `color` (the output's format) with `depth` to the filter, to come out with `pts`
 /// and `duration`; the frame joins the frames in flight.
 GstFlowReturn submit(GstDefocus* self, GstVideoFrame* color, GstBuffer* depth, GstVideoInfo* depthInfo,
@@ -989,11 +1006,6 @@ GstFlowReturn submit(GstDefocus* self, GstVideoFrame* color, GstBuffer* depth, G
         GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("%s", error.what()), (nullptr));
         return GST_FLOW_ERROR;
     }
-    if (s.resetPending) {
-        dropInFlight(s);
-        s.resetPending = false;
-    }
-
     // The element's own mappings: the colour pad's is cleaned when this returns, and the depth
     // frame may be replaced before the frame is received.
     InFlight frame;
@@ -1006,19 +1018,11 @@ GstFlowReturn submit(GstDefocus* self, GstVideoFrame* color, GstBuffer* depth, G
         GST_ELEMENT_ERROR(self, STREAM, FAILED, ("A colour or depth frame could not be mapped"), (nullptr));
         return GST_FLOW_ERROR;
     }
-    try {
-        s.filter->submit(toFilter(&frame.color), depthOf(&frame.depth), setup.seconds);
-    } catch (const defocus::Error& error) {
-        unmap(frame);
-        GST_ELEMENT_ERROR(self, STREAM, FORMAT, ("%s", error.what()), (nullptr));
-        return GST_FLOW_ERROR;
-    } catch (const cv::Exception& error) {
-        unmap(frame);
-        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("%s", error.what()), (nullptr));
-        return GST_FLOW_ERROR;
-    }
-    s.inFlight.push_back(frame);
-    return GST_FLOW_OK;
+    const GstFlowReturn ret = guarded(
+        self, frame, [&] { s.filter->submit(toFilter(&frame.color), depthOf(&frame.depth), setup.seconds); });
+    if (ret == GST_FLOW_OK)
+        s.inFlight.push_back(frame);
+    return ret;
 }
 
 /// Receives the oldest frame in flight from the filter and pushes it downstream with its
@@ -1031,20 +1035,14 @@ GstFlowReturn pushOldest(GstDefocus* self)
     InFlight frame = s.inFlight.front();
     s.inFlight.pop_front();
     cv::Mat result;
-    try {
+    const GstFlowReturn received = guarded(self, frame, [&] {
         const defocus::gst::LibraryCall call(GST_ELEMENT(self));
         result = s.filter->receive().value();
         if (frame.post)
             postTimings(self, s.filter->lastFrame(), frame.pts);
-    } catch (const defocus::Error& error) {
-        unmap(frame);
-        GST_ELEMENT_ERROR(self, STREAM, FORMAT, ("%s", error.what()), (nullptr));
-        return GST_FLOW_ERROR;
-    } catch (const cv::Exception& error) {
-        unmap(frame);
-        GST_ELEMENT_ERROR(self, STREAM, FAILED, ("%s", error.what()), (nullptr));
-        return GST_FLOW_ERROR;
-    }
+    });
+    if (received != GST_FLOW_OK)
+        return received;
     unmap(frame);
 
     GstBuffer* outbuf = nullptr;
@@ -1070,10 +1068,6 @@ GstFlowReturn pushOldest(GstDefocus* self)
 GstFlowReturn pushReceived(GstDefocus* self, bool all)
 {
     State& s = *self->state;
-    if (s.resetPending) { // a flush: frames from before it are not pushed
-        dropInFlight(s);
-        s.resetPending = false;
-    }
     GstFlowReturn ret = GST_FLOW_OK;
     while (ret == GST_FLOW_OK && !s.inFlight.empty() &&
            (all || s.inFlight.size() >= defocus::Filter::kFramesInFlight))
@@ -1271,6 +1265,10 @@ GstFlowReturn aggregate(GstAggregator* agg, gboolean timeout)
     auto* depth = GST_AGGREGATOR_PAD(depthPad);
     if (s.depthStale.exchange(false))
         gst_clear_buffer(&s.depthFrame); // a flush: depth from before it is not this stream's
+    // A flush: the frames in flight from before it are not pushed, and the next frame starts a
+    // new stream (the GL path resets its own filter on its thread).
+    if (!s.glOutput && s.resetPending.exchange(false))
+        dropInFlight(s);
 
     GstBuffer* colorBuffer = gst_aggregator_pad_peek_buffer(color);
     if (!colorBuffer) {
