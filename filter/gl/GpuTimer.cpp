@@ -101,8 +101,7 @@ GpuTimer::Results GpuTimer::read(Set& set)
         else
             results.emplace_back(set.scopes[i].name, static_cast<double>(ns) * 1e-6);
     }
-    set.used = 0;
-    set.state = State::Free;
+    release(set);
     return results;
 }
 
@@ -112,12 +111,10 @@ GpuTimer::Results GpuTimer::swap(std::uint64_t frame)
         return {};
     const std::size_t ending = open(frame);
     for (Set& set : sets_)
-        if (set.state == State::Open && set.frame < frame) {
-            set.used = 0;
-            set.state = State::Free;
-        }
+        if (set.state == State::Open && set.frame < frame)
+            release(set);
     Results results;
-    if (ended_ != static_cast<std::size_t>(-1))
+    if (ended_ != kNoSet)
         results = read(sets_[ended_]);
     sets_[ending].state = State::Ended;
     ended_ = ending;
@@ -126,19 +123,17 @@ GpuTimer::Results GpuTimer::swap(std::uint64_t frame)
 
 GpuTimer::Results GpuTimer::drain()
 {
-    if (ended_ == static_cast<std::size_t>(-1))
+    if (ended_ == kNoSet)
         return {};
-    const std::size_t set = std::exchange(ended_, static_cast<std::size_t>(-1));
+    const std::size_t set = std::exchange(ended_, kNoSet);
     return read(sets_[set]);
 }
 
 void GpuTimer::forget(std::uint64_t frame)
 {
     for (Set& set : sets_)
-        if (set.state == State::Open && set.frame == frame) {
-            set.used = 0;
-            set.state = State::Free;
-        }
+        if (set.state == State::Open && set.frame == frame)
+            release(set);
 }
 
 } // namespace defocus::gl

@@ -60,6 +60,13 @@ private:
     };
     /// The index of frame `frame`'s open set, opened from a free one (or a new one) if need be.
     std::size_t open(std::uint64_t frame);
+    /// Frees `set` for another frame (its queries are kept, to be reused).
+    static void release(Set& set)
+    {
+        set.used = 0;
+        set.state = State::Free;
+    }
+    static constexpr std::size_t kNoSet = static_cast<std::size_t>(-1);
     Results read(Set& set);
 
     bool enabled_;
@@ -67,7 +74,7 @@ private:
     std::chrono::steady_clock::time_point started_;
     std::vector<Set> sets_;
     std::size_t timing_ = 0;                     ///< the set of the scope begun
-    std::size_t ended_ = static_cast<std::size_t>(-1); ///< the set ended by the last swap(); -1: none
+    std::size_t ended_ = kNoSet;                 ///< the set ended by the last swap()
 };
 
 } // namespace defocus::gl
