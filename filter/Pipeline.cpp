@@ -318,6 +318,18 @@ struct Pipeline::Impl {
     std::size_t gpuFrameIndex = 0; ///< frame whose GPU scopes are pending in the timer
     std::uint64_t serials = 0;     ///< frames begun
 
+    /// Whether the blur passes draw or run as compute shaders (Pipeline::computePasses()).
+    void setStage(ShaderStage stage)
+    {
+        cocPass.setStage(stage);
+        rhombusBlurPass.setStage(stage);
+        hexBlurPass.setStage(stage);
+        compositePass.setStage(stage);
+        copyPass.setStage(stage);
+        nearBlurPass.setStage(stage);
+        upscalePass.setStage(stage);
+        depthPrepPass.setStage(stage);
+    }
     /// The frame's nodes (FrameGraph: frameNodes()), once a frame.
     void render();
     /// `view` of the last frame rendered into `out` (not for a frame all in focus): the view's
@@ -386,6 +398,7 @@ Pipeline::Pipeline(bool timers)
     GLint bits = 0;
     glGetQueryiv(GL_TIME_ELAPSED, GL_QUERY_COUNTER_BITS, &bits);
     impl_ = std::make_unique<Impl>(timers && bits > 0);
+    impl_->setStage(gl::computePasses(rendererName()) ? ShaderStage::Compute : ShaderStage::Fragment);
     // Only sRGB-format attachments are affected: those get linear -> sRGB encoding on write.
     glEnable(GL_FRAMEBUFFER_SRGB);
     glDisable(GL_DEPTH_TEST);
@@ -1071,6 +1084,11 @@ const cv::Mat& Pipeline::filledDepth()
 void Pipeline::prepareOnGpu(bool on)
 {
     impl_->prepareOnGpu = on;
+}
+
+void Pipeline::computePasses(bool on)
+{
+    impl_->setStage(on ? ShaderStage::Compute : ShaderStage::Fragment);
 }
 
 double Pipeline::invalidDepthFraction() const

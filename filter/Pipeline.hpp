@@ -160,6 +160,13 @@ public:
     /// (llvmpipe), where it is faster; tests and benchmarks hold the two side by side.
     void prepareOnGpu(bool on);
 
+    /// The passes that shade each pixel once (depth prep, CoC, rhombi, McIntosh's blurs,
+    /// composite, copies, prefilter, upscale) as compute shaders, or drawn with their fragment
+    /// shaders: the same shaders and the same frames (ComputePassesGLTest). Compute by default on
+    /// a GPU, drawn on a software renderer (gl::computePasses()). The bokeh sprites and the light
+    /// in focus blend into the output, and the views draw, either way.
+    void computePasses(bool on);
+
     /// The pooled targets the last frame's nodes hold: one per image of FrameGraph's pool that
     /// a node it ran wrote, none for an image nothing writes (tests hold it to the graph).
     std::size_t targetsHeld() const;

@@ -141,7 +141,8 @@ RendererInfo toRendererInfo(const gl::ContextInfo& info)
             info.glVersion,
             info.timerQueries,
             gl::depthPrepOnGpu(info.glRenderer),
-            gl::halfFloatTargets(info.glRenderer)};
+            gl::halfFloatTargets(info.glRenderer),
+            gl::computePasses(info.glRenderer)};
 }
 
 gl::ContextOptions toContextOptions(const ContextOptions& options)

@@ -112,10 +112,12 @@ int printInfo(const Options& options)
                    d.drmFile.empty() ? "" : ", " + d.drmFile, d.cudaId ? fmt::format(", CUDA device {}", *d.cudaId) : "");
     const RendererInfo info = probeRenderer(contextOptions(options));
     fmt::print("EGL platform: {}{}\nEGL vendor:   {}\nEGL version:  {}\nGL vendor:    {}\nGL renderer:  {}\n"
-               "GL version:   {}\nGPU timers:   {}\nDepth prep:   {}\nPrecision:    {} (the presets', the renderer's)\n",
+               "GL version:   {}\nGPU timers:   {}\nDepth prep:   {}\nPrecision:    {} (the presets', the renderer's)\n"
+               "Passes:       {} shaders\n",
                info.platform, info.eglDevice >= 0 ? fmt::format(" (EGL device {})", info.eglDevice) : "", info.eglVendor,
                info.eglVersion, info.glVendor, info.glRenderer, info.glVersion, info.timerQueries ? "yes" : "no",
-               info.depthPrepOnGpu ? "GPU" : "CPU", info.halfFloatTargets ? "16f" : "32f");
+               info.depthPrepOnGpu ? "GPU" : "CPU", info.halfFloatTargets ? "16f" : "32f",
+               info.computePasses ? "compute" : "fragment");
     return kExitDone;
 }
 

@@ -24,7 +24,6 @@
 #include "coc_params.glsl"
 #include "highlights.glsl"
 
-layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
 layout(binding = 0) uniform sampler2D uColor; // sRGB8 textures decode to linear on fetch

@@ -6,7 +6,6 @@
 // the same three directional blurs, using the largest foreground CoC that can reach each pixel
 // (tile maxima dilated on the CPU) instead of the pixel's own; the composite lays it over the
 // result by its blurred coverage.
-layout(location = 0) in vec2 vUv;
 layout(location = 0) out vec4 outColor;
 
 layout(binding = 0) uniform sampler2D uSource;     // first pass: rgb + signed CoC; then premultiplied layer
@@ -33,6 +32,10 @@ vec4 layer(vec4 texel, float diameter)
 
 void main()
 {
+    // The pixel centre from gl_FragCoord, not tiles.vert's interpolated uv, which rounds
+    // otherwise and moved the bilinear taps by an ulp: the drawn pass and its compute form
+    // (which has no interpolation) then differed by up to 5e-4.
+    const vec2 vUv = gl_FragCoord.xy / vec2(textureSize(uSource, 0));
     const float diameter = textureLod(uNearRadius, vUv, 0.0).r;
     const vec4 center = layer(texelFetch(uSource, ivec2(gl_FragCoord.xy), 0), diameter);
     if (diameter < 0.5) {

@@ -794,17 +794,23 @@ TEST_F(CliFlags, InfoPrintsThePlatformAndExits)
 
 // Defect: --info not saying where depth prep runs or the presets' precision, or saying other
 // than the renderer's choice: the CPU and 32f on a software renderer, the GPU and 16f on a GPU;
-// DEFOCUS_DEPTH_PREP overriding it.
+// DEFOCUS_DEPTH_PREP overriding it; the same for the passes' shaders (fragment on a software
+// renderer, compute on a GPU) and DEFOCUS_PASSES.
 TEST_F(CliFlags, InfoSaysWhereDepthPrepRunsAndThePresetsPrecision)
 {
     const Ran r = defocus("--info");
     const bool software = softwareRenderer();
     EXPECT_NE(r.out.find(software ? "Depth prep:   CPU" : "Depth prep:   GPU"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find(software ? "Precision:    32f" : "Precision:    16f"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(software ? "Passes:       fragment" : "Passes:       compute"), std::string::npos) << r.out;
     ::setenv("DEFOCUS_DEPTH_PREP", software ? "gpu" : "cpu", 1);
+    ::setenv("DEFOCUS_PASSES", software ? "compute" : "fragment", 1);
     const Ran chosen = defocus("--info");
     ::unsetenv("DEFOCUS_DEPTH_PREP");
+    ::unsetenv("DEFOCUS_PASSES");
     EXPECT_NE(chosen.out.find(software ? "Depth prep:   GPU" : "Depth prep:   CPU"), std::string::npos) << chosen.out;
+    EXPECT_NE(chosen.out.find(software ? "Passes:       compute" : "Passes:       fragment"), std::string::npos)
+        << chosen.out;
 }
 
 // Defects: -q printing the log, -v not adding the debug lines, --version not the version.

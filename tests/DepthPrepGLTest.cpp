@@ -15,7 +15,6 @@
 #include "filter/Pipeline.hpp"
 #include "filter/Presets.hpp"
 #include "sources/FrameSource.hpp"
-#include "sources/ImageIO.hpp"
 #include "tests/GLTestSupport.hpp"
 #include "tests/TestSupport.hpp"
 
@@ -42,16 +41,6 @@ Frame tumFrame()
 {
     const std::vector<Frame> frames = tumFrames(1);
     return frames.empty() ? Frame{} : frames.front();
-}
-
-/// The corpus' railing-lights scene: float colour with lights above white over depth edges.
-Frame railingLights()
-{
-    const auto dir = test::dataDir() / "corpus" / "railing-lights";
-    Frame frame;
-    frame.color = readColor(dir / "color_linear.exr");
-    frame.depth = readDepth(dir / "depth_mm.png", 1000.0);
-    return frame;
 }
 
 LensSettings tumLens()
@@ -159,7 +148,7 @@ TEST_F(DepthPrepGpu, GpuPutsAFrameWithoutMeasurementsAtTheFocusDistance)
 // the sprites' light and the gather's disagree with the CPU's.
 TEST_F(DepthPrepGpu, GpuPutsLightEdgesAtTheirLightsDepthAsTheCpuDoes)
 {
-    const Frame frame = railingLights();
+    const Frame frame = test::railingLights();
     // The CPU's own step, to know that this frame has edges to move.
     PreparedDepth filled = prepareDepth(frame.depth, frame.color.size(), 1.0f);
     ASSERT_GT(putLightEdgesAtTheirLightsDepth(frame.color, filled.metres), 50u);
@@ -181,7 +170,7 @@ TEST_F(DepthPrepGpu, GpuPutsLightEdgesAtTheirLightsDepthAsTheCpuDoes)
 TEST_F(DepthPrepGpu, GpuMeasuresTheSceneAsTheCpuDoes)
 {
     const Frame tum = tumFrame();
-    const Frame lights = railingLights();
+    const Frame lights = test::railingLights();
     SideBySide pipelines;
     for (const Frame* frame : std::initializer_list<const Frame*>{&tum, &lights}) {
         pipelines.run(*frame, tumLens(), presetSettings("balanced"));

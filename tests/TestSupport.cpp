@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "filter/Presets.hpp"
+#include "sources/ImageIO.hpp"
 
 namespace defocus::test {
 
@@ -36,6 +37,15 @@ CliResult runDefocus(const std::string& arguments)
     const int status = ::pclose(pipe);
     result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return result;
+}
+
+Frame railingLights()
+{
+    const auto dir = dataDir() / "corpus" / "railing-lights";
+    Frame frame;
+    frame.color = readColor(dir / "color_linear.exr");
+    frame.depth = readDepth(dir / "depth_mm.png", 1000.0);
+    return frame;
 }
 
 std::filesystem::path scratchDir(const std::string& name)

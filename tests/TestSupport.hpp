@@ -14,6 +14,7 @@
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
+#include "defocus/Frame.hpp"
 #include "filter/Log.hpp"
 #include "filter/Settings.hpp"
 
@@ -21,6 +22,9 @@ namespace defocus::test {
 
 /// The repository's data/ folder (bundled fixtures).
 std::filesystem::path dataDir();
+/// The corpus' railing-lights scene (data/corpus): float colour with lights above white over
+/// depth edges, behind thin foreground bars; its depth in metres.
+Frame railingLights();
 /// A fresh, empty folder under the build tree for one test's files.
 std::filesystem::path scratchDir(const std::string& name);
 

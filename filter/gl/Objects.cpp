@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include <fmt/format.h>
+
 namespace defocus::gl {
 
 void deleteTexture(GLuint id) { glDeleteTextures(1, &id); }
@@ -75,6 +77,7 @@ Framebuffer::Framebuffer(const Texture& texture, std::string_view name)
     handle_ = Handle<deleteFramebuffer>(id);
     glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0, texture.id(), 0);
     label(GL_FRAMEBUFFER, id, name);
+    addStore(0, texture, name);
 }
 
 Framebuffer::Framebuffer(const Texture& first, const Texture& second, std::string_view name)
@@ -89,6 +92,8 @@ Framebuffer::Framebuffer(const Texture& first, const Texture& second, std::strin
     const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glNamedFramebufferDrawBuffers(id, 2, buffers);
     label(GL_FRAMEBUFFER, id, name);
+    addStore(0, first, name);
+    addStore(1, second, name);
 }
 
 Framebuffer::Framebuffer(GLuint texture, int width, int height, std::string_view name)
@@ -105,6 +110,30 @@ void Framebuffer::bindForDraw() const
 {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, id());
     glViewport(0, 0, width_, height_);
+}
+
+void Framebuffer::addStore(int index, const Texture& texture, std::string_view name)
+{
+    Store& store = stores_[index];
+    store.texture = texture.id();
+    store.format = texture.format();
+    store.srgb = texture.format() == GL_SRGB8_ALPHA8;
+    if (store.srgb) {
+        store.bytes = Texture::view(texture, GL_RGBA8, fmt::format("{}, bytes", name));
+        store.texture = store.bytes.id();
+        store.format = GL_RGBA8;
+    }
+    storeCount_ = index + 1;
+}
+
+unsigned Framebuffer::bindForStore() const
+{
+    unsigned srgb = 0;
+    for (int i = 0; i < storeCount_; ++i) {
+        glBindImageTexture(static_cast<GLuint>(i), stores_[i].texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, stores_[i].format);
+        srgb |= stores_[i].srgb ? 1u << i : 0u;
+    }
+    return srgb;
 }
 
 Sampler::Sampler(GLenum filter, std::string_view name, GLenum wrap)

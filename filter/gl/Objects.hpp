@@ -110,10 +110,27 @@ public:
     /// Binds for drawing and sets the viewport to the whole attachment.
     void bindForDraw() const;
 
+    /// The attachments a compute shader stores into in place of drawing (0 for a caller's texture).
+    int storeCount() const { return storeCount_; }
+    /// Binds attachment i to image unit i, write-only (an sRGB one as its bytes: image stores
+    /// cannot encode sRGB). Returns a bit per attachment the shader must encode as sRGB itself.
+    unsigned bindForStore() const;
+
 private:
+    /// Records `texture` as attachment `index` for bindForStore().
+    void addStore(int index, const Texture& texture, std::string_view name);
+
     Handle<deleteFramebuffer> handle_;
     int width_ = 0;
     int height_ = 0;
+    struct Store {
+        GLuint texture = 0;
+        GLenum format = 0;
+        bool srgb = false;
+        Texture bytes; ///< an sRGB attachment's view as its bytes
+    };
+    Store stores_[2];
+    int storeCount_ = 0;
 };
 
 /// A sampler object: filtering and edge clamping, separate from the texture.

@@ -14,15 +14,31 @@ bool isSoftwareRenderer(std::string_view glRenderer)
            glRenderer.find("Software Rasterizer") != std::string_view::npos;
 }
 
+namespace {
+
+/// The choice `variable` makes: `onValue` true, `offValue` false, unset the renderer's default
+/// (a GPU's: true); another value is warned about and ignored.
+bool chosen(const char* variable, std::string_view onValue, std::string_view offValue, std::string_view glRenderer)
+{
+    const char* set = std::getenv(variable);
+    const std::string_view value = set ? set : "";
+    if (value == onValue || value == offValue)
+        return value == onValue;
+    if (!value.empty())
+        logger().warn("{}='{}' is neither '{}' nor '{}': ignored", variable, value, onValue, offValue);
+    return !isSoftwareRenderer(glRenderer);
+}
+
+} // namespace
+
 bool depthPrepOnGpu(std::string_view glRenderer)
 {
-    const char* chosen = std::getenv("DEFOCUS_DEPTH_PREP");
-    const std::string_view value = chosen ? chosen : "";
-    if (value == "gpu" || value == "cpu")
-        return value == "gpu";
-    if (!value.empty())
-        logger().warn("DEFOCUS_DEPTH_PREP='{}' is neither 'gpu' nor 'cpu': ignored", value);
-    return !isSoftwareRenderer(glRenderer);
+    return chosen("DEFOCUS_DEPTH_PREP", "gpu", "cpu", glRenderer);
+}
+
+bool computePasses(std::string_view glRenderer)
+{
+    return chosen("DEFOCUS_PASSES", "compute", "fragment", glRenderer);
 }
 
 } // namespace defocus::gl

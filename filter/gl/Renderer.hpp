@@ -20,6 +20,13 @@ bool isSoftwareRenderer(std::string_view glRenderer);
 /// paying 15 ns a pixel and its compute shaders' barriers more (docs/benchmarks.md).
 bool depthPrepOnGpu(std::string_view glRenderer);
 
+/// The passes' fragment shaders run as compute shaders on this renderer, unless told otherwise:
+/// DEFOCUS_PASSES=compute or fragment chooses on any renderer (tests and profiling; another value
+/// is warned about and ignored); otherwise compute on a GPU, whose datacenter parts draw on a
+/// few of their processing clusters and compute on all of them, and fragment on a software
+/// renderer, where image stores cost more than a fragment's output (docs/benchmarks.md).
+bool computePasses(std::string_view glRenderer);
+
 /// The presets' precision on this renderer: half-float targets on a GPU, full float on a software
 /// renderer, which converts half floats on every fetch and store.
 inline bool halfFloatTargets(std::string_view glRenderer)

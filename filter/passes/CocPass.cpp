@@ -35,13 +35,11 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocP
         neighbourhoods->bind(1);
     (sprites ? *sprites : noSprites_).bind(2);
     params.bind();
-    target.bindForDraw();
     assert(sizeShift >= 0 && sizeShift <= 2);
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
     bindTexture(2, color.id(), linear_.id());
-    (sizeShift == 0 ? program_ : sizeShift == 1 ? halfProgram_ : quarterProgram_).use();
-    drawFullscreenTriangle();
+    shade(sizeShift == 0 ? program_ : sizeShift == 1 ? halfProgram_ : quarterProgram_, target, nullptr, stage_);
 
     // Highlights are treated pixel by pixel (at half size, four fetches instead of one mean),
     // only on the tiles that have them: elsewhere recovery leaves a pixel as it is and no pixel is
@@ -55,11 +53,10 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocP
     assert(sizeShift < 2 || !withSprites);
     if (highlightTiles->count() == 0)
         return;
-    (sizeShift == 0   ? spritesProgram_
-     : sizeShift == 1 ? (withSprites ? halfSpritesProgram_ : halfHighlightsProgram_)
-                      : quarterHighlightsProgram_)
-        .use();
-    highlightTiles->draw();
+    shade(sizeShift == 0   ? spritesProgram_
+          : sizeShift == 1 ? (withSprites ? halfSpritesProgram_ : halfHighlightsProgram_)
+                           : quarterHighlightsProgram_,
+          target, highlightTiles, stage_);
 }
 
 } // namespace defocus

@@ -7,6 +7,7 @@
 #include "filter/gl/Program.hpp"
 #include "filter/passes/CocParams.hpp"
 #include "filter/passes/TileList.hpp"
+#include "filter/passes/Pass.hpp"
 
 namespace defocus {
 
@@ -34,6 +35,9 @@ public:
              const gl::Framebuffer& target, int sizeShift = 0, const gl::StorageBuffer* neighbourhoods = nullptr,
              const gl::StorageBuffer* sprites = nullptr, const TileList* highlightTiles = nullptr);
 
+    /// Draws its fragment shaders or runs them as compute shaders (shade()).
+    void setStage(ShaderStage stage) { stage_ = stage; }
+
 private:
     /// The plain variants, full-screen: every pixel of a frame without highlights, and the others'
     /// pixels before their highlight tiles are drawn over.
@@ -46,6 +50,7 @@ private:
     gl::StorageBuffer noSprites_; ///< bound for the sprite count where there are no sprites
     gl::Sampler nearest_;
     gl::Sampler linear_;
+    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

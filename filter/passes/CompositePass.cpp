@@ -17,26 +17,21 @@ CompositePass::CompositePass()
 void CompositePass::run(const gl::Texture& diagonalA, const gl::Texture& diagonalB, const gl::Framebuffer& target,
                         const gl::Texture* nearA, const gl::Texture* nearB)
 {
-    target.bindForDraw();
     bindTexture(0, diagonalA.id(), nearest_.id());
     bindTexture(1, diagonalB.id(), nearest_.id());
-    if (nearA && nearB) {
-        nearProgram_.use();
+    const bool near = nearA && nearB;
+    if (near) {
         bindTexture(2, nearA->id(), nearest_.id());
         bindTexture(3, nearB->id(), nearest_.id());
-    } else {
-        program_.use();
     }
-    drawFullscreenTriangle();
+    shade(near ? nearProgram_ : program_, target, nullptr, stage_);
 }
 
 void CompositePass::runSum(const gl::Texture& a, const gl::Texture& b, const gl::Framebuffer& target)
 {
-    target.bindForDraw();
     bindTexture(0, a.id(), nearest_.id());
     bindTexture(1, b.id(), nearest_.id());
-    sumProgram_.use();
-    drawFullscreenTriangle();
+    shade(sumProgram_, target, nullptr, stage_);
 }
 
 } // namespace defocus

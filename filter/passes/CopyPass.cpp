@@ -15,10 +15,8 @@ CopyPass::CopyPass()
 
 void CopyPass::run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target, bool twoTargets)
 {
-    target.bindForDraw();
-    (twoTargets ? twoTargetProgram_ : program_).use();
     bindTexture(0, source.id(), nearest_.id());
-    tiles.draw();
+    shade(twoTargets ? twoTargetProgram_ : program_, target, &tiles, stage_);
 }
 
 } // namespace defocus

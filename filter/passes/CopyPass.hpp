@@ -5,6 +5,7 @@
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
 #include "filter/passes/TileList.hpp"
+#include "filter/passes/Pass.hpp"
 
 namespace defocus {
 
@@ -16,10 +17,14 @@ public:
     /// both (the rhombus passes' pair of targets).
     void run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target, bool twoTargets = false);
 
+    /// Draws its fragment shaders or runs them as compute shaders (shade()).
+    void setStage(ShaderStage stage) { stage_ = stage; }
+
 private:
     gl::Program program_;
     gl::Program twoTargetProgram_;
     gl::Sampler nearest_;
+    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

@@ -30,12 +30,10 @@ DepthPrepPass::DepthPrepPass()
 {
 }
 
-void DepthPrepPass::draw(const gl::Program& program, const gl::Framebuffer& target)
+void DepthPrepPass::draw(const gl::Program& program, const gl::Framebuffer& target) const
 {
-    program.use();
-    glUniform2i(kSizeLocation, target.width(), target.height());
-    target.bindForDraw();
-    drawFullscreenTriangle();
+    glProgramUniform2i(staged(program).id(), kSizeLocation, target.width(), target.height());
+    shade(program, target, nullptr, stage_);
 }
 
 void DepthPrepPass::run(const gl::Texture* depth, double unitsPerMetre, float fallbackM,
@@ -80,8 +78,7 @@ void DepthPrepPass::run(const gl::Texture* depth, double unitsPerMetre, float fa
             }
         glBindTextureUnit(0, depth->id());
         if (unitsPerMetre > 0.0) {
-            splitUnits_.use();
-            glUniform1f(kMetresPerUnitLocation, static_cast<float>(1.0 / unitsPerMetre));
+            glProgramUniform1f(staged(splitUnits_).id(), kMetresPerUnitLocation, static_cast<float>(1.0 / unitsPerMetre));
             draw(splitUnits_, levels_[0].pyramidTarget);
         } else {
             draw(split_, levels_[0].pyramidTarget);
@@ -102,8 +99,7 @@ void DepthPrepPass::run(const gl::Texture* depth, double unitsPerMetre, float fa
         glBindTextureUnit(0, levels_[0].pyramid.id());
         glBindTextureUnit(1, filledOf(1));
         glBindTextureUnit(2, levels_[count - 1].pyramid.id());
-        fill_.use();
-        glUniform1f(kFallbackLocation, fallbackM);
+        glProgramUniform1f(staged(fill_).id(), kFallbackLocation, fallbackM);
         draw(fill_, target);
     }
     if (lightColor) {

@@ -10,6 +10,7 @@
 
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
+#include "filter/passes/Pass.hpp"
 
 namespace defocus {
 
@@ -29,6 +30,9 @@ public:
     /// holes (SceneMeasurePass counts them). Empty until a run with depth.
     const gl::Texture& measured() const { return levels_.empty() ? none_ : levels_.front().pyramid; }
 
+    /// Draws its fragment shaders or runs them as compute shaders (shade()).
+    void setStage(ShaderStage stage) { stage_ = stage; }
+
 private:
     struct Level {
         gl::Texture pyramid;    ///< RG32F: depth, weight
@@ -41,7 +45,13 @@ private:
     static constexpr GLint kFallbackLocation = 1; ///< uFallbackM (FILL)
     static constexpr GLint kMetresPerUnitLocation = 2; ///< uMetresPerUnit (SPLIT of 16-bit depth)
     /// Draws `program` over the whole of `target`.
-    static void draw(const gl::Program& program, const gl::Framebuffer& target);
+    /// `program` over `target` (its size set), drawn or dispatched (setStage()).
+    void draw(const gl::Program& program, const gl::Framebuffer& target) const;
+    /// The program of `program` that runs: itself or its compute form.
+    const gl::Program& staged(const gl::Program& program) const
+    {
+        return stage_ == ShaderStage::Compute ? program.computeForm() : program;
+    }
 
     gl::Program split_, splitUnits_, push_, pull_, fill_, lightEdges_;
     gl::Sampler nearest_;
@@ -50,6 +60,7 @@ private:
     gl::Texture unlit_; ///< the filled depth before the light edges
     gl::Framebuffer unlitTarget_;
     gl::Texture none_;
+    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

@@ -53,16 +53,9 @@ void HexBlurPass::run(const gl::Texture& source, const gl::Texture& depth, float
     u.maxTapSpacing = kMaxTapSpacingPx;
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
-    target.bindForDraw();
     bindTexture(0, source.id(), linear_.id());
     bindTexture(1, depth.id(), nearest_.id());
-    if (tiles) {
-        tileProgram_.use();
-        tiles->draw();
-    } else {
-        program_.use();
-        drawFullscreenTriangle();
-    }
+    shade(tiles ? tileProgram_ : program_, target, tiles, stage_);
 }
 
 } // namespace defocus

@@ -9,6 +9,7 @@
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
 #include "filter/passes/TileList.hpp"
+#include "filter/passes/Pass.hpp"
 
 namespace defocus {
 
@@ -33,6 +34,9 @@ public:
     /// -d/2 to +d/2 along the angle, divided by the image size so that pixels stay square.
     static std::vector<glm::vec2> offsets(float angleDegrees, int samples, int width, int height);
 
+    /// Draws its fragment shaders or runs them as compute shaders (shade()).
+    void setStage(ShaderStage stage) { stage_ = stage; }
+
 private:
     /// Mirrors the std140 block HexBlurParams in hex_blur.frag.
     struct Uniforms {
@@ -48,6 +52,7 @@ private:
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
     gl::Sampler nearest_;
+    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

@@ -33,10 +33,9 @@ void NearBlurPass::run(const gl::Texture& source, const gl::Texture& nearRadius,
     target.bindForDraw();
     const float transparent[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glClearBufferfv(GL_COLOR, 0, transparent);
-    program_.use();
     bindTexture(0, source.id(), linear_.id());
     bindTexture(2, nearRadius.id(), linear_.id());
-    tiles.draw();
+    shade(program_, target, &tiles, stage_);
 }
 
 } // namespace defocus

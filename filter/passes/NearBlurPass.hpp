@@ -6,6 +6,7 @@
 #include "filter/gl/Program.hpp"
 #include "filter/passes/HexBlurPass.hpp"
 #include "filter/passes/TileList.hpp"
+#include "filter/passes/Pass.hpp"
 
 namespace defocus {
 
@@ -17,6 +18,9 @@ public:
     /// foreground layer is made from it on the fly. Draws `tiles` after clearing the target.
     void run(const gl::Texture& source, const gl::Texture& nearRadius, float angleDegrees, int samples,
              bool firstPass, const gl::Framebuffer& target, const TileList& tiles);
+
+    /// Draws its fragment shaders or runs them as compute shaders (shade()).
+    void setStage(ShaderStage stage) { stage_ = stage; }
 
 private:
     /// Mirrors the std140 block NearBlurParams in near_blur.frag.
@@ -30,6 +34,7 @@ private:
     gl::Program program_;
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
+    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

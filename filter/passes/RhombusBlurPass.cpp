@@ -208,7 +208,6 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
     uniforms_.update(&u, sizeof u);
     uniforms_.bind(0);
 
-    io.target.bindForDraw();
     const gl::Texture& second = first ? io.sourceA : *io.sourceB;
     bindTexture(0, io.sourceA.id(), nearest_.id());
     bindTexture(1, io.sourceA.id(), linear_.id());
@@ -216,11 +215,8 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
     bindTexture(4, second.id(), linear_.id());
     if (io.nearDiameter)
         bindTexture(2, io.nearDiameter->id(), nearest_.id());
-    program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, mode3, taps, fused, unrolled).use();
-    if (tiles)
-        tiles->draw();
-    else
-        drawFullscreenTriangle();
+    shade(program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, mode3, taps, fused, unrolled),
+          io.target, tiles, stage_);
 }
 
 } // namespace defocus

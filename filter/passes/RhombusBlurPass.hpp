@@ -10,6 +10,7 @@
 #include "filter/gl/Objects.hpp"
 #include "filter/gl/Program.hpp"
 #include "filter/passes/TileList.hpp"
+#include "filter/passes/Pass.hpp"
 
 namespace defocus {
 
@@ -76,6 +77,9 @@ public:
     void run(const Io& io, bool first, const Directions& directions, int taps, int tileSize,
              const TileList* tiles = nullptr, bool fused = false, bool unrolled = true);
 
+    /// Draws its fragment shaders or runs them as compute shaders (shade()).
+    void setStage(ShaderStage stage) { stage_ = stage; }
+
 private:
     /// Mirrors the std140 block RhombusBlurParams in rhombus_blur.frag.
     struct Uniforms {
@@ -103,6 +107,7 @@ private:
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
     gl::Sampler nearest_;
+    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

@@ -2,6 +2,8 @@
 // Tile instances: one ivec2 per tile in a vertex buffer, advanced once per instance.
 #include "filter/passes/TileList.hpp"
 
+#include <algorithm>
+
 namespace defocus {
 
 TileList::TileList() : uniforms_(sizeof(Uniforms), "tile params")
@@ -30,6 +32,7 @@ void TileList::set(const std::vector<cv::Point>& tiles, cv::Size targetSize, int
     }
     if (bytes > 0)
         glNamedBufferSubData(buffer_.id(), 0, bytes, tiles.data());
+    tileSize_ = tileSize;
     const Uniforms u{{static_cast<float>(targetSize.width), static_cast<float>(targetSize.height)},
                      static_cast<float>(tileSize), 0.0f};
     uniforms_.update(&u, sizeof u);
@@ -45,6 +48,22 @@ void TileList::draw() const
     glBindVertexArray(vao_.id());
     glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count_);
     glBindVertexArray(static_cast<GLuint>(previous));
+}
+
+void TileList::dispatch() const
+{
+    if (count_ == 0)
+        return;
+    uniforms_.bind(1);
+    // The range of this frame's tiles: the shader's computeTiles.length() is their count.
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 7, buffer_.id(), 0,
+                      static_cast<GLsizeiptr>(count_) * static_cast<GLsizeiptr>(sizeof(cv::Point)));
+    // One work group per 8x8 block of a tile; tiles in rows of at most 65535 (the least
+    // GL_MAX_COMPUTE_WORK_GROUP_COUNT a driver may have), then layers of such rows.
+    constexpr int kRows = 65535;
+    const int blocksPerRow = (tileSize_ + 7) / 8;
+    glDispatchCompute(static_cast<GLuint>(blocksPerRow * blocksPerRow), static_cast<GLuint>(std::min(count_, kRows)),
+                      static_cast<GLuint>((count_ + kRows - 1) / kRows));
 }
 
 } // namespace defocus

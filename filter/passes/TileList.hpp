@@ -20,6 +20,9 @@ public:
     /// Binds the tile parameters (uniform binding 1) and draws every tile; the program must use
     /// tiles.vert and the target must be bound.
     void draw() const;
+    /// Binds the tile parameters and the tiles (storage binding 7) and dispatches a compute
+    /// form of a program drawn with tiles.vert over every tile (gl::computeFormSource()).
+    void dispatch() const;
 
 private:
     struct Uniforms {
@@ -32,6 +35,7 @@ private:
     gl::UniformBuffer uniforms_;
     GLsizeiptr capacity_ = 0;
     int count_ = 0;
+    int tileSize_ = 0;
 };
 
 } // namespace defocus

@@ -47,33 +47,26 @@ UpscalePass::UpscalePass()
 
 void UpscalePass::prefilter(const Io& io)
 {
-    io.prefiltered.bindForDraw();
-    prefilter_.use();
     bindTexture(0, io.blurred.id(), nearest_.id());
     bindTexture(1, io.halfInput.id(), nearest_.id());
-    drawFullscreenTriangle();
+    shade(prefilter_, io.prefiltered, nullptr, stage_);
 }
 
 void UpscalePass::upscale(const Io& io, const CocParams& params, int sizeShift, const TileList* detailTiles)
 {
     Programs& programs = sizeShift == 2 ? quarter_ : half_;
     params.bind();
-    io.target.bindForDraw();
     bindTexture(0, io.color.id(), nearest_.id());
     bindTexture(1, io.depth.id(), nearest_.id());
     bindTexture(2, io.sharpened.id(), linear_.id());
     bindTexture(3, io.added.id(), linear_.id());
     if (!detailTiles) {
-        programs.full.use();
-        drawFullscreenTriangle();
+        shade(programs.full, io.target, nullptr, stage_);
         return;
     }
-    programs.interpolateOnly.use();
-    drawFullscreenTriangle();
-    if (detailTiles->count() > 0) {
-        programs.detailTiles.use();
-        detailTiles->draw();
-    }
+    shade(programs.interpolateOnly, io.target, nullptr, stage_);
+    if (detailTiles->count() > 0)
+        shade(programs.detailTiles, io.target, detailTiles, stage_);
 }
 
 } // namespace defocus

@@ -8,6 +8,7 @@
 #include "filter/gl/Program.hpp"
 #include "filter/passes/CocParams.hpp"
 #include "filter/passes/TileList.hpp"
+#include "filter/passes/Pass.hpp"
 
 namespace defocus {
 
@@ -43,6 +44,9 @@ public:
     /// quarter size.
     void upscale(const Io& io, const CocParams& params, int sizeShift, const TileList* detailTiles = nullptr);
 
+    /// Draws its fragment shaders or runs them as compute shaders (shade()).
+    void setStage(ShaderStage stage) { stage_ = stage; }
+
 private:
     struct Programs {
         gl::Program full;            ///< the detail, full screen
@@ -54,6 +58,7 @@ private:
     gl::Program prefilter_;
     gl::Sampler nearest_;
     gl::Sampler linear_;
+    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

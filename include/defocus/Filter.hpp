@@ -149,6 +149,9 @@ struct RendererInfo {
     /// The presets' render targets are half float (Quality::precision left to the renderer):
     /// on a GPU; full float on a software renderer.
     bool halfFloatTargets = false;
+    /// The passes run as compute shaders (on a GPU), or draw with fragment shaders (on a
+    /// software renderer). DEFOCUS_PASSES=compute or fragment chooses on any renderer.
+    bool computePasses = false;
 };
 
 /// The EGL display (an initialised EGLDisplay) a Filter with a context of its own renders on
