@@ -75,6 +75,10 @@ struct Options : cli::QualityNames {
     /// defocused scene with them on the CPU (Pipeline::prepareOnGpu off), in a second pipeline,
     /// frames alternating as above.
     bool versusCpuPrep = false;
+    /// The passes as compute shaders in the main pipeline, and also the defocused scene with
+    /// them drawn by their fragment shaders (Pipeline::computePasses off), in a second pipeline,
+    /// frames alternating as above.
+    bool versusFragment = false;
     std::string json;
 };
 
@@ -453,6 +457,12 @@ int run(const Options& options, const std::string& commandLine)
         versusPipeline->finishEachPass(options.finishEachPass);
         versusPipeline->prepareOnGpu(false);
         versusScene = "CPU depth prep";
+    } else if (options.versusFragment) {
+        pipeline.computePasses(true); // whatever the renderer's default
+        versusPipeline.emplace(!options.noTimers);
+        versusPipeline->finishEachPass(options.finishEachPass);
+        versusPipeline->computePasses(false);
+        versusScene = "fragment passes";
     }
 
     const unsigned cores = std::thread::hardware_concurrency();
@@ -474,6 +484,9 @@ int run(const Options& options, const std::string& commandLine)
                                                                            : "RGBA32F (the renderer's)"),
                quality.adaptive ? "adaptive (in-focus frames and tiles skipped)" : "every pass on every pixel",
                options.runs, options.warmup);
+    fmt::print("passes: {} shaders{}\n",
+               options.versusFragment || gl::computePasses(info.glRenderer) ? "compute" : "fragment",
+               options.versusFragment ? "" : " (the renderer's; DEFOCUS_PASSES=compute or fragment chooses)");
     fmt::print("lens: thin lens {} mm f/{} focused at {} m, 36 mm sensor, max-coc {} px per 640 px of width\n",
                options.focalLengthMm, options.fNumber, options.focusM, options.maxCocAt640);
     if (options.versusHalfOnly)
@@ -482,6 +495,9 @@ int run(const Options& options, const std::string& commandLine)
     if (options.versusCpuPrep)
         fmt::print("versus: the defocused scene also with depth prep and the scene measurement on the CPU, the "
                    "filled depth uploaded, in a second pipeline, frames alternating between the two\n");
+    if (options.versusFragment)
+        fmt::print("versus: the passes as compute shaders, and the defocused scene also with them drawn by their "
+                   "fragment shaders, in a second pipeline, frames alternating between the two\n");
     fmt::print("GPU = {}{}; wall = CPU clock; readback waits for the GPU to finish.\n"
                "Sizes other than the clip's are resized from it (aspect not kept); a row of n/a: the pass did "
                "not run.\nother processes' CPU %: share of all cores other programs used during the runs; "
@@ -573,6 +589,7 @@ int run(const Options& options, const std::string& commandLine)
               {"finishEachPass", options.finishEachPass},
               {"versusHalfOnly", options.versusHalfOnly},
               {"versusCpuPrep", options.versusCpuPrep},
+              {"versusFragment", options.versusFragment},
               {"quarterOnLargeBlur", quality.quarterOnLargeBlur},
               {"focusM", options.focusM},
               {"fNumber", options.fNumber},
@@ -722,11 +739,17 @@ int main(int argc, char** argv)
     auto* halfOnly = app.add_flag("--versus-half-only", o.versusHalfOnly,
                  "Also time the defocused scene always at half size (quarter size on large blur off: the path "
                  "before it), frames alternating with the main settings', and print the ratio of frame times");
-    app.add_flag("--versus-cpu-prep", o.versusCpuPrep,
+    auto* cpuPrep = app.add_flag("--versus-cpu-prep", o.versusCpuPrep,
                  "Depth prep and the scene measurement on the GPU (the default but on software renderers), and "
                  "also the defocused scene with them on the CPU (the filled depth uploaded), frames alternating "
                  "with the GPU's, and print the ratio of frame times")
         ->excludes(halfOnly);
+    app.add_flag("--versus-fragment", o.versusFragment,
+                 "The passes as compute shaders (the default but on software renderers), and also the defocused "
+                 "scene with them drawn by their fragment shaders, frames alternating with the compute ones', and "
+                 "print the ratio of frame times")
+        ->excludes(halfOnly)
+        ->excludes(cpuPrep);
     app.add_flag("--finish-each-pass", o.finishEachPass,
                  "Profiling: glFinish before and after each pass, and wall ms per pass instead of timer queries "
                  "(llvmpipe renders at a flush, so its queries need not fall on the pass that was issued)");

@@ -61,12 +61,22 @@ case ${1:-} in
     # Depth prep and the scene measurement on the GPU against the CPU's, frames alternating.
     step prep "$unpacked/bin/defocus-bench" --sizes "$sizes" --runs "$frames" --warmup 5 --versus-cpu-prep \
       --json "$out/bench-prep.json"
+    # The passes as compute shaders against the same shaders drawn, frames alternating, and the
+    # frames out of both (one 1080p frame per preset, and their largest difference).
+    step compute "$unpacked/bin/defocus-bench" --sizes "$sizes" --runs "$frames" --warmup 5 --versus-fragment \
+      --json "$out/bench-compute.json"
+    for preset in fast balanced high; do
+      for stage in compute fragment; do
+        DEFOCUS_PASSES=$stage "$unpacked/bin/defocus" data/tum_fr1_rpy --focus 1.0 --f-number 1.4 --frames 1 \
+          --quality "$preset" -y -o "$out/frame-$preset-$stage.exr" > /dev/null 2>&1 || true
+      done
+    done
     # The apertures beside the hexagon (needs python3-opencv there to make the frames).
     for size in 1920x1080 3840x2160; do
       step "apertures-$size" scripts/aperture-cost.sh "$unpacked/bin" data/corpus/spheres-far-focus "$size" 20 3 ||
         echo "gpu-figures: apertures at $size not measured (see $out/apertures-$size.txt)"
     done
-    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, prep.txt, bench-prep.json, apertures-*.txt"
+    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, prep.txt, bench-prep.json, compute.txt, bench-compute.json, frame-*.exr, apertures-*.txt"
     ;;
   *)
     echo "usage: scripts/gpu-figures.sh pack [BUILD_DIR] | run [OUT_DIR]" >&2
