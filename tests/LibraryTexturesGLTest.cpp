@@ -256,13 +256,18 @@ TEST_F(LibraryTextures, SameBytesForOtherPresetsViewsAndFramesInFocus)
 }
 
 // Defect caught: a GL binding or switch of the caller's left as the filter's (an sRGB switch left
-// on brightens what GStreamer draws next; a sampler left bound overrides its textures' filtering).
+// on brightens what GStreamer draws next; a sampler left bound overrides its textures' filtering;
+// an image unit left on a target of the filter's, where the passes run as compute shaders:
+// library_textures_gpu_defaults, a caller's compute shader would store into the filter's target).
 TEST_F(LibraryTextures, LeavesTheCallersStateAsItWas)
 {
     GLuint framebuffer = 0, sampler = 0, texture = 0;
     glCreateFramebuffers(1, &framebuffer);
     glCreateSamplers(1, &sampler);
     glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+    glTextureStorage2D(texture, 1, GL_RGBA8, 4, 4);
+    glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R8);
+    glBindImageTexture(1, texture, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA8);
     glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
     glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_2D, texture);
@@ -297,6 +302,16 @@ TEST_F(LibraryTextures, LeavesTheCallersStateAsItWas)
     EXPECT_EQ(cv::Vec4i(viewport[0], viewport[1], viewport[2], viewport[3]), cv::Vec4i(1, 2, 3, 4));
     EXPECT_EQ(integer(GL_CURRENT_PROGRAM), 0);
     EXPECT_EQ(integer(GL_VERTEX_ARRAY_BINDING), 0);
+    const auto image = [](GLenum name, GLuint unit) {
+        GLint value = -1;
+        glGetIntegeri_v(name, unit, &value);
+        return value;
+    };
+    EXPECT_EQ(image(GL_IMAGE_BINDING_NAME, 0), 0);
+    EXPECT_EQ(image(GL_IMAGE_BINDING_NAME, 1), static_cast<GLint>(texture));
+    EXPECT_EQ(image(GL_IMAGE_BINDING_ACCESS, 1), GL_READ_WRITE);
+    EXPECT_EQ(image(GL_IMAGE_BINDING_FORMAT, 1), GL_RGBA8);
+    glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R8);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glBindSampler(0, 0);
     glDisable(GL_BLEND);

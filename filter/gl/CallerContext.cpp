@@ -84,6 +84,16 @@ CallerState::CallerState()
         glGetIntegerv(GL_SAMPLER_BINDING, &samplers_[static_cast<std::size_t>(unit)]);
     }
     glActiveTexture(static_cast<GLenum>(activeTexture_));
+    for (int unit = 0; unit < kImageUnits; ++unit) {
+        ImageUnit& image = images_[static_cast<std::size_t>(unit)];
+        const auto index = static_cast<GLuint>(unit);
+        glGetIntegeri_v(GL_IMAGE_BINDING_NAME, index, &image.texture);
+        glGetIntegeri_v(GL_IMAGE_BINDING_LEVEL, index, &image.level);
+        glGetIntegeri_v(GL_IMAGE_BINDING_LAYERED, index, &image.layered);
+        glGetIntegeri_v(GL_IMAGE_BINDING_LAYER, index, &image.layer);
+        glGetIntegeri_v(GL_IMAGE_BINDING_ACCESS, index, &image.access);
+        glGetIntegeri_v(GL_IMAGE_BINDING_FORMAT, index, &image.format);
+    }
     glGetIntegerv(GL_PACK_ALIGNMENT, &packAlignment_);
     glGetIntegerv(GL_UNPACK_ALIGNMENT, &unpackAlignment_);
     glGetIntegerv(GL_PACK_ROW_LENGTH, &packRowLength_);
@@ -130,6 +140,12 @@ CallerState::~CallerState()
         glBindSampler(static_cast<GLuint>(unit), static_cast<GLuint>(samplers_[static_cast<std::size_t>(unit)]));
     }
     glActiveTexture(static_cast<GLenum>(activeTexture_));
+    for (int unit = 0; unit < kImageUnits; ++unit) {
+        const ImageUnit& image = images_[static_cast<std::size_t>(unit)];
+        glBindImageTexture(static_cast<GLuint>(unit), static_cast<GLuint>(image.texture), image.level,
+                           static_cast<GLboolean>(image.layered), image.layer, static_cast<GLenum>(image.access),
+                           static_cast<GLenum>(image.format));
+    }
     glPixelStorei(GL_PACK_ALIGNMENT, packAlignment_);
     glPixelStorei(GL_UNPACK_ALIGNMENT, unpackAlignment_);
     glPixelStorei(GL_PACK_ROW_LENGTH, packRowLength_);

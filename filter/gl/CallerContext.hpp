@@ -34,12 +34,14 @@ cv::Mat readDepthTexture(GLuint texture, DepthTexture format);
 /// blending, depth, stencil, scissor and culling off; additive blending when a pass enables it;
 /// all colour channels written; tight pixel rows; no pixel buffers bound); then the caller's again:
 /// the framebuffers, viewport, program, vertex array, active texture, the 2D texture and sampler
-/// bindings of units [0, kUnits), pixel-store alignment and row length, pixel buffers, draw-indirect
-/// and the generic uniform and storage buffers, blend function and equation, colour mask and
-/// those enables. Indexed uniform and storage buffer bindings are not put back.
+/// bindings of units [0, kUnits), the image units the compute passes store through [0,
+/// kImageUnits), pixel-store alignment and row length, pixel buffers, draw-indirect and the
+/// generic uniform and storage buffers, blend function and equation, colour mask and those
+/// enables. Indexed uniform and storage buffer bindings are not put back.
 class CallerState {
 public:
     static constexpr int kUnits = 8;
+    static constexpr int kImageUnits = 2;
     CallerState();
     ~CallerState();
     CallerState(const CallerState&) = delete;
@@ -52,6 +54,10 @@ private:
     GLint drawFramebuffer_ = 0, readFramebuffer_ = 0, program_ = 0, vertexArray_ = 0, activeTexture_ = 0;
     GLint viewport_[4] = {0, 0, 0, 0};
     std::array<GLint, kUnits> textures_{}, samplers_{};
+    struct ImageUnit {
+        GLint texture = 0, level = 0, layered = GL_FALSE, layer = 0, access = GL_READ_ONLY, format = GL_R8;
+    };
+    std::array<ImageUnit, kImageUnits> images_{};
     GLint packAlignment_ = 4, unpackAlignment_ = 4, packRowLength_ = 0, unpackRowLength_ = 0;
     GLint packBuffer_ = 0, unpackBuffer_ = 0, indirectBuffer_ = 0, uniformBuffer_ = 0, storageBuffer_ = 0;
     GLint blendSrcRgb_ = GL_ONE, blendDstRgb_ = GL_ZERO, blendSrcAlpha_ = GL_ONE, blendDstAlpha_ = GL_ZERO;
