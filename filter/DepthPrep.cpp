@@ -160,7 +160,7 @@ std::size_t putLightEdgesAtTheirLightsDepth(const cv::Mat& colorLinear, cv::Mat&
                             brightest = b;
                             at = {qx, qy};
                         }
-                if (const float z = metres.at<float>(at); z < metres.at<float>(y, x))
+                if (const float z = metres.at<float>(at); z != metres.at<float>(y, x))
                     changes.emplace_back(cv::Point{x, y}, z);
             }
         }

@@ -53,12 +53,13 @@ void prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM, DepthPre
 
 /// A pixel of `colorLinear` (CV_32FC3, linear BGR) above white (Rec. 709 luminance > 1) takes,
 /// in `metres` (CV_32FC1, the same size, filled), the depth of the brightest pixel of its 3x3
-/// neighbourhood when that one is brighter and nearer. A light's antialiased edge mixes the light
-/// with what lies behind it, and a renderer's depth (or a sensor's) gives such a pixel one depth,
-/// often the background's: its share of the light then takes the background's blur, a pale
-/// hexagon as large as that blur around a light in front of it (docs/accuracy.md, "What each
-/// improvement bought"). Nearer only: a light beside a nearer occluder whose antialiased edge is
-/// above white (a railing's bar in front of it) keeps its own depth. Returns the pixels changed.
+/// neighbourhood when that one is brighter. A light's antialiased edge mixes the light with what
+/// lies behind it or in front of it, and a renderer's depth (or a sensor's) gives such a pixel
+/// one depth, the other surface's: its share of the light then took that surface's blur, a pale
+/// hexagon as large as that blur around a light in front of a background, or beside the
+/// nearer bar of a railing in front of a light (docs/accuracy.md, "What each improvement
+/// bought"). The other surface's share of the pixel then takes the light's blur: one pixel's
+/// worth. Returns the pixels changed.
 std::size_t putLightEdgesAtTheirLightsDepth(const cv::Mat& colorLinear, cv::Mat& metres);
 
 /// Depth of another size is resized to the colour, but only at the same aspect ratio: they agree

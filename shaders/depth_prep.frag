@@ -165,7 +165,7 @@ void main()
                     at = ivec2(x, y);
                 }
             }
-        z = min(z, texelFetch(uDepth, at, 0).r); // nearer only
+        z = texelFetch(uDepth, at, 0).r;
     }
     outDepth = z;
 }

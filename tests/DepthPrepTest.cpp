@@ -149,14 +149,15 @@ TEST(DepthPrep, CentreDepthIsTheMedianOfValidCentrePixels)
 
 TEST(DepthPrep, LightEdgesTakeTheLightsDepthDecidedOnTheDepthAsItWas)
 {
-    // Catches the edge rule changing pixels it should not: a change applied during the scan (it
-    // then spreads from the light's edge outwards, pixel by pixel), a band of rows left out, or a
-    // pixel moved to a farther neighbour's depth. A 64 x 48 float frame at 10 m: a light of 50 at
-    // 2 m in rows 20-22, columns 30-32, a ring of 10 around it and a second ring of 2 (both above
-    // white) at the background's depth: the first ring takes 2 m, the second keeps 10 m (its
-    // brightest neighbour, the first ring, was at 10 m). In row 40: a pixel of 50 at 10 m beside
-    // a brighter one of 60 at 1 m takes 1 m; a pixel of 50 at 1 m beside one of 60 at 10 m keeps
-    // 1 m.
+    // Catches the edge rule changing pixels it should not, or not changing those it should: a
+    // change applied during the scan (it then spreads from the light's edge outwards, pixel by
+    // pixel), a band of rows left out, a pixel moved to a dimmer neighbour's depth, or one kept at
+    // its own beside a brighter, farther light (an occluder's edge in front of a light). A 64 x 48
+    // float frame at 10 m: a light of 50 at 2 m in rows 20-22, columns 30-32, a ring of 10 around
+    // it and a second ring of 2 (both above white) at the background's depth: the first ring
+    // takes 2 m, the second keeps 10 m (its brightest neighbour, the first ring, was at 10 m). In
+    // row 40: a pixel of 50 at 10 m beside a brighter one of 60 at 1 m takes 1 m; a pixel of 50 at
+    // 1 m beside one of 60 at 10 m takes 10 m; one of 60 at 1 m beside one of 50 at 10 m keeps 1 m.
     cv::Mat color(48, 64, CV_32FC3, cv::Scalar::all(0.1));
     cv::Mat depth(color.size(), CV_32F, cv::Scalar(10.0f));
     const auto ring = [&](int radius, float level) {
@@ -175,15 +176,20 @@ TEST(DepthPrep, LightEdgesTakeTheLightsDepthDecidedOnTheDepthAsItWas)
     color.at<cv::Vec3f>(40, 50) = cv::Vec3f::all(50.0f);
     depth.at<float>(40, 50) = 1.0f;
     color.at<cv::Vec3f>(40, 51) = cv::Vec3f::all(60.0f);
+    color.at<cv::Vec3f>(40, 20) = cv::Vec3f::all(60.0f);
+    depth.at<float>(40, 20) = 1.0f;
+    color.at<cv::Vec3f>(40, 21) = cv::Vec3f::all(50.0f);
     cv::Mat expected = depth.clone();
     for (int y = 19; y <= 23; ++y)
         for (int x = 29; x <= 33; ++x)
             if (std::max(std::abs(y - 21), std::abs(x - 31)) == 2)
                 expected.at<float>(y, x) = 2.0f;
     expected.at<float>(40, 10) = 1.0f;
+    expected.at<float>(40, 50) = 10.0f;
+    expected.at<float>(40, 21) = 1.0f; // the dimmer one beside it, at 10 m, takes the brighter's 1 m
     cv::Mat metres = depth.clone();
     const std::size_t changed = putLightEdgesAtTheirLightsDepth(color, metres);
-    EXPECT_EQ(changed, 17u);
+    EXPECT_EQ(changed, 19u);
     EXPECT_EQ(cv::norm(metres, expected, cv::NORM_INF), 0.0);
 }
 

@@ -22,7 +22,7 @@ public:
     /// Fills `filledDepth` (R32F, the frame's size; `filled` its framebuffer) from `depth` (R32F
     /// metres, or with `unitsPerMetre` > 0 R16UI in those units; nullptr: the frame has no depth,
     /// and all of it sits at `fallbackM`, as when no pixel of `depth` is a measurement). `lightColor`: a float frame's linear colour, whose
-    /// pixels above white take the depth of the brightest nearer pixel round them; nullptr: no
+    /// pixels above white take the depth of the brightest pixel round them if brighter; nullptr: no
     /// such step. Needs a vertex array bound (the full-screen triangle).
     void run(const gl::Texture* depth, double unitsPerMetre, float fallbackM, const gl::Texture* lightColor,
              const gl::Texture& filledDepth, const gl::Framebuffer& filled);
