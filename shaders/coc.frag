@@ -71,6 +71,26 @@ float sharpest(vec4 c)
     return abs(c01) <= abs(c23) ? c01 : c23;
 }
 
+#ifdef HALF_SIZE
+// A half-size texel on the frame's border holds the colour of the frame's border pixels of its
+// block only (the first or last row, column or corner), not the whole 2x2 block's mean. The
+// blurs read past the frame's edge the edge texels repeated (the samplers clamp), as at full size
+// they repeat the frame's edge pixels; a block's mean there brought the row inside it out past
+// the edge too: a light band along the frame's top edge (overlapping-lights' mortar line, half
+// of whose bricks lie above the frame) came out at the block's half, and 49 % of that scene's
+// squared error lay in its top 8 rows. Its CoC stays the block's (the gather below).
+// The corners of the block `a`..`b` of the texel: moved onto the border row and column.
+ivec2 edgeLow(ivec2 texel, ivec2 a, ivec2 b)
+{
+    const ivec2 lastTexel = (textureSize(uColor, 0) + 1) / 2 - 1;
+    return ivec2(texel.x == lastTexel.x ? b.x : a.x, texel.y == lastTexel.y ? b.y : a.y);
+}
+ivec2 edgeHigh(ivec2 texel, ivec2 a, ivec2 b)
+{
+    return ivec2(texel.x == 0 ? a.x : b.x, texel.y == 0 ? a.y : b.y);
+}
+#endif
+
 void main()
 {
     const ivec2 texel = ivec2(gl_FragCoord.xy);
@@ -102,20 +122,29 @@ void main()
         }
     outColor = vec4(sanitizeColor(0.25 * sum, largestColor), 0.25 * coc);
 #elif defined(HALF_SIZE) && defined(HIGHLIGHTS)
-    // Highlight recovery needs each pixel's own colour and CoC.
+    // Highlight recovery needs each pixel's own colour and CoC. On the frame's border, the
+    // colour of the border's pixels only (edgeLow()).
     const ivec2 last = textureSize(uColor, 0) - 1;
     const ivec2 a = 2 * texel, b = min(a + 1, last);
     const vec4 p0 = pixel(a), p1 = pixel(ivec2(b.x, a.y)), p2 = pixel(ivec2(a.x, b.y)), p3 = pixel(b);
-    outColor = vec4(0.25 * (p0.rgb + p1.rgb + p2.rgb + p3.rgb), 0.5 * sharpest(vec4(p0.a, p1.a, p2.a, p3.a)));
+    vec3 sum = p0.rgb + p1.rgb + p2.rgb + p3.rgb;
+    const ivec2 lo = edgeLow(texel, a, b), hi = edgeHigh(texel, a, b);
+    if (lo != a || hi != b)
+        sum = pixel(lo).rgb + pixel(ivec2(hi.x, lo.y)).rgb + pixel(ivec2(lo.x, hi.y)).rgb + pixel(hi).rgb;
+    outColor = vec4(0.25 * sum, 0.5 * sharpest(vec4(p0.a, p1.a, p2.a, p3.a)));
 #elif defined(HALF_SIZE)
     // One bilinear fetch at the block's corner is the mean of its colours (sRGB decoded before
     // filtering), one gather its four depths: 1.3 instead of 3.7 ms on llvmpipe at 640x480.
     // Sanitised after the mean: a NaN or Inf pixel takes its block with it (to 0 or the largest
-    // colour), where the frame-sized pass loses only the pixel.
-    const vec2 uv = vec2(2 * texel + 1) / vec2(textureSize(uColor, 0));
+    // colour), where the frame-sized pass loses only the pixel. On the frame's border, the
+    // colour of the border's pixels only (edgeLow()): the fetch at their centre line.
+    const vec2 size = vec2(textureSize(uColor, 0));
+    const vec2 uv = vec2(2 * texel + 1) / size;
     const vec4 z = textureGather(uDepth, uv, 0);
     const vec4 c = vec4(signedCoc(z.x), signedCoc(z.y), signedCoc(z.z), signedCoc(z.w));
-    outColor = vec4(sanitizeColor(textureLod(uColorSmooth, uv, 0.0).rgb, largestColor), 0.5 * sharpest(c));
+    const ivec2 a = 2 * texel, b = min(a + 1, textureSize(uColor, 0) - 1);
+    const vec2 colorUv = (vec2(edgeLow(texel, a, b) + edgeHigh(texel, a, b)) * 0.5 + 0.5) / size;
+    outColor = vec4(sanitizeColor(textureLod(uColorSmooth, colorUv, 0.0).rgb, largestColor), 0.5 * sharpest(c));
 #else
     outColor = pixel(texel);
 #endif
