@@ -48,7 +48,7 @@ const std::vector<Preset>& presets()
     // repeated) and of 2026-11-29 (every nearer tap that its own blur does not reach lights
     // nothing, not only one above white; half-size border texels holding the frame's border),
     // measured with `defocus-bench-accuracy --scene data/blender_spheres --scene data/corpus
-    // --presets fast,balanced,high` (2026-11-29 07:12 UTC): 35.03, 35.37 and 36.65 dB; the table
+    // --presets fast,balanced,high` (2026-11-29 06:50 UTC, at a9dd182): 35.03, 35.37 and 36.65 dB; the table
     // in filter/Presets.cpp, the ms and the choice predate them. The edges took 0.24-0.34 dB from
     // this scene (read mirrored, they measured better here) and raised the corpus.
     static const std::map<std::string, Figures, std::less<>> figures{
