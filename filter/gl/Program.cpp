@@ -243,6 +243,7 @@ const Program& Program::computeForm() const
         auto program = std::make_unique<Program>();
         program->link({compileSource(GL_COMPUTE_SHADER, fragmentFile_, computeFormSource(fragmentFile_, defines_, tiles_))},
                       name);
+        program->computeSrgbLocation_ = program->uniform("uComputeSrgb");
         computeForm_ = std::move(program);
     }
     return *computeForm_;

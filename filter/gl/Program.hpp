@@ -41,6 +41,8 @@ public:
     /// (computeFormSource()), built on first use and kept; its uniform uComputeSrgb says which
     /// outputs to encode as sRGB. Throws ShaderError (and for a compute program).
     const Program& computeForm() const;
+    /// A compute form's uComputeSrgb, looked up once when it was built (-1 elsewhere).
+    GLint computeSrgbLocation() const { return computeSrgbLocation_; }
 
 private:
     /// Links the compiled `shaders` (and deletes them), labelled `name`; throws ShaderError.
@@ -52,6 +54,7 @@ private:
     std::string fragmentFile_, name_;
     std::vector<std::string> defines_;
     bool tiles_ = false;
+    GLint computeSrgbLocation_ = -1;
     mutable std::unique_ptr<Program> computeForm_;
 };
 

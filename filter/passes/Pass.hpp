@@ -48,7 +48,7 @@ inline void shade(const gl::Program& program, const gl::Framebuffer& target, con
     const gl::Program& compute = program.computeForm();
     compute.use();
     assert(target.storeCount() > 0);
-    glProgramUniform1ui(compute.id(), compute.uniform("uComputeSrgb"), target.bindForStore());
+    glProgramUniform1ui(compute.id(), compute.computeSrgbLocation(), target.bindForStore());
     if (tiles)
         tiles->dispatch();
     else
