@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <initializer_list>
 #include <map>
 #include <mutex>
 #include <string_view>
@@ -321,14 +322,9 @@ struct Pipeline::Impl {
     /// Whether the blur passes draw or run as compute shaders (Pipeline::computePasses()).
     void setStage(ShaderStage stage)
     {
-        cocPass.setStage(stage);
-        rhombusBlurPass.setStage(stage);
-        hexBlurPass.setStage(stage);
-        compositePass.setStage(stage);
-        copyPass.setStage(stage);
-        nearBlurPass.setStage(stage);
-        upscalePass.setStage(stage);
-        depthPrepPass.setStage(stage);
+        for (ShadedPass* pass : std::initializer_list<ShadedPass*>{&cocPass, &rhombusBlurPass, &hexBlurPass, &compositePass,
+                                                                   &copyPass, &nearBlurPass, &upscalePass, &depthPrepPass})
+            pass->setStage(stage);
     }
     /// The frame's nodes (FrameGraph: frameNodes()), once a frame.
     void render();

@@ -39,7 +39,7 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocP
     bindTexture(0, color.id(), nearest_.id());
     bindTexture(1, depth.id(), nearest_.id());
     bindTexture(2, color.id(), linear_.id());
-    shade(sizeShift == 0 ? program_ : sizeShift == 1 ? halfProgram_ : quarterProgram_, target, nullptr, stage_);
+    shade(sizeShift == 0 ? program_ : sizeShift == 1 ? halfProgram_ : quarterProgram_, target);
 
     // Highlights are treated pixel by pixel (at half size, four fetches instead of one mean),
     // only on the tiles that have them: elsewhere recovery leaves a pixel as it is and no pixel is
@@ -56,7 +56,7 @@ void CocPass::run(const gl::Texture& color, const gl::Texture& depth, const CocP
     shade(sizeShift == 0   ? spritesProgram_
           : sizeShift == 1 ? (withSprites ? halfSpritesProgram_ : halfHighlightsProgram_)
                            : quarterHighlightsProgram_,
-          target, highlightTiles, stage_);
+          target, highlightTiles);
 }
 
 } // namespace defocus

@@ -11,7 +11,7 @@
 
 namespace defocus {
 
-class CocPass {
+class CocPass : public ShadedPass {
 public:
     static constexpr const char* kName = "coc";
     CocPass();
@@ -35,9 +35,6 @@ public:
              const gl::Framebuffer& target, int sizeShift = 0, const gl::StorageBuffer* neighbourhoods = nullptr,
              const gl::StorageBuffer* sprites = nullptr, const TileList* highlightTiles = nullptr);
 
-    /// Draws its fragment shaders or runs them as compute shaders (shade()).
-    void setStage(ShaderStage stage) { stage_ = stage; }
-
 private:
     /// The plain variants, full-screen: every pixel of a frame without highlights, and the others'
     /// pixels before their highlight tiles are drawn over.
@@ -50,7 +47,6 @@ private:
     gl::StorageBuffer noSprites_; ///< bound for the sprite count where there are no sprites
     gl::Sampler nearest_;
     gl::Sampler linear_;
-    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

@@ -24,14 +24,14 @@ void CompositePass::run(const gl::Texture& diagonalA, const gl::Texture& diagona
         bindTexture(2, nearA->id(), nearest_.id());
         bindTexture(3, nearB->id(), nearest_.id());
     }
-    shade(near ? nearProgram_ : program_, target, nullptr, stage_);
+    shade(near ? nearProgram_ : program_, target);
 }
 
 void CompositePass::runSum(const gl::Texture& a, const gl::Texture& b, const gl::Framebuffer& target)
 {
     bindTexture(0, a.id(), nearest_.id());
     bindTexture(1, b.id(), nearest_.id());
-    shade(sumProgram_, target, nullptr, stage_);
+    shade(sumProgram_, target);
 }
 
 } // namespace defocus

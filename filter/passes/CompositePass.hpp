@@ -10,7 +10,7 @@
 
 namespace defocus {
 
-class CompositePass {
+class CompositePass : public ShadedPass {
 public:
     static constexpr const char* kName = "composite";
     CompositePass();
@@ -20,15 +20,11 @@ public:
     /// (A + 2 B) / 3 of the second rhombus pass's targets (rhombus_blur.frag).
     void runSum(const gl::Texture& a, const gl::Texture& b, const gl::Framebuffer& target);
 
-    /// Draws its fragment shaders or runs them as compute shaders (shade()).
-    void setStage(ShaderStage stage) { stage_ = stage; }
-
 private:
     gl::Program program_;
     gl::Program nearProgram_; ///< NEAR_FIELD variant
     gl::Program sumProgram_;  ///< SUM variant
     gl::Sampler nearest_;
-    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

@@ -16,7 +16,7 @@ CopyPass::CopyPass()
 void CopyPass::run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target, bool twoTargets)
 {
     bindTexture(0, source.id(), nearest_.id());
-    shade(twoTargets ? twoTargetProgram_ : program_, target, &tiles, stage_);
+    shade(twoTargets ? twoTargetProgram_ : program_, target, &tiles);
 }
 
 } // namespace defocus

@@ -9,7 +9,7 @@
 
 namespace defocus {
 
-class CopyPass {
+class CopyPass : public ShadedPass {
 public:
     static constexpr const char* kName = "copy";
     CopyPass();
@@ -17,14 +17,10 @@ public:
     /// both (the rhombus passes' pair of targets).
     void run(const gl::Texture& source, const TileList& tiles, const gl::Framebuffer& target, bool twoTargets = false);
 
-    /// Draws its fragment shaders or runs them as compute shaders (shade()).
-    void setStage(ShaderStage stage) { stage_ = stage; }
-
 private:
     gl::Program program_;
     gl::Program twoTargetProgram_;
     gl::Sampler nearest_;
-    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

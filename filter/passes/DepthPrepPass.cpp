@@ -33,7 +33,7 @@ DepthPrepPass::DepthPrepPass()
 void DepthPrepPass::draw(const gl::Program& program, const gl::Framebuffer& target) const
 {
     glProgramUniform2i(staged(program).id(), kSizeLocation, target.width(), target.height());
-    shade(program, target, nullptr, stage_);
+    shade(program, target);
 }
 
 void DepthPrepPass::run(const gl::Texture* depth, double unitsPerMetre, float fallbackM,

@@ -14,7 +14,7 @@
 
 namespace defocus {
 
-class DepthPrepPass {
+class DepthPrepPass : public ShadedPass {
 public:
     static constexpr const char* kName = "depth-prep";
     DepthPrepPass();
@@ -29,9 +29,6 @@ public:
     /// The frame's size, RG32F: g is 1 where the last run's depth had a measurement, 0 at its
     /// holes (SceneMeasurePass counts them). Empty until a run with depth.
     const gl::Texture& measured() const { return levels_.empty() ? none_ : levels_.front().pyramid; }
-
-    /// Draws its fragment shaders or runs them as compute shaders (shade()).
-    void setStage(ShaderStage stage) { stage_ = stage; }
 
 private:
     struct Level {
@@ -50,7 +47,7 @@ private:
     /// The program of `program` that runs: itself or its compute form.
     const gl::Program& staged(const gl::Program& program) const
     {
-        return stage_ == ShaderStage::Compute ? program.computeForm() : program;
+        return stage() == ShaderStage::Compute ? program.computeForm() : program;
     }
 
     gl::Program split_, splitUnits_, push_, pull_, fill_, lightEdges_;
@@ -60,7 +57,6 @@ private:
     gl::Texture unlit_; ///< the filled depth before the light edges
     gl::Framebuffer unlitTarget_;
     gl::Texture none_;
-    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

@@ -55,7 +55,7 @@ void HexBlurPass::run(const gl::Texture& source, const gl::Texture& depth, float
     uniforms_.bind(0);
     bindTexture(0, source.id(), linear_.id());
     bindTexture(1, depth.id(), nearest_.id());
-    shade(tiles ? tileProgram_ : program_, target, tiles, stage_);
+    shade(tiles ? tileProgram_ : program_, target, tiles);
 }
 
 } // namespace defocus

@@ -13,7 +13,7 @@
 
 namespace defocus {
 
-class HexBlurPass {
+class HexBlurPass : public ShadedPass {
 public:
     static constexpr int kMaxSamples = 64;
     /// The paper's bleeding fix constants, in its unit (CoC as a fraction of image height).
@@ -34,9 +34,6 @@ public:
     /// -d/2 to +d/2 along the angle, divided by the image size so that pixels stay square.
     static std::vector<glm::vec2> offsets(float angleDegrees, int samples, int width, int height);
 
-    /// Draws its fragment shaders or runs them as compute shaders (shade()).
-    void setStage(ShaderStage stage) { stage_ = stage; }
-
 private:
     /// Mirrors the std140 block HexBlurParams in hex_blur.frag.
     struct Uniforms {
@@ -52,7 +49,6 @@ private:
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
     gl::Sampler nearest_;
-    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

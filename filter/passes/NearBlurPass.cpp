@@ -35,7 +35,7 @@ void NearBlurPass::run(const gl::Texture& source, const gl::Texture& nearRadius,
     glClearBufferfv(GL_COLOR, 0, transparent);
     bindTexture(0, source.id(), linear_.id());
     bindTexture(2, nearRadius.id(), linear_.id());
-    shade(program_, target, &tiles, stage_);
+    shade(program_, target, &tiles);
 }
 
 } // namespace defocus

@@ -10,7 +10,7 @@
 
 namespace defocus {
 
-class NearBlurPass {
+class NearBlurPass : public ShadedPass {
 public:
     NearBlurPass();
     /// Blurs `source` along `angleDegrees` over the diameter in `nearRadius` (a per-tile R32F
@@ -18,9 +18,6 @@ public:
     /// foreground layer is made from it on the fly. Draws `tiles` after clearing the target.
     void run(const gl::Texture& source, const gl::Texture& nearRadius, float angleDegrees, int samples,
              bool firstPass, const gl::Framebuffer& target, const TileList& tiles);
-
-    /// Draws its fragment shaders or runs them as compute shaders (shade()).
-    void setStage(ShaderStage stage) { stage_ = stage; }
 
 private:
     /// Mirrors the std140 block NearBlurParams in near_blur.frag.
@@ -34,7 +31,6 @@ private:
     gl::Program program_;
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
-    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

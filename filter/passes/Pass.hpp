@@ -57,4 +57,23 @@ inline void shade(const gl::Program& program, const gl::Framebuffer& target, con
                     GL_PIXEL_BUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
 }
 
+/// A pass that shades its targets with shade(): it keeps whether it draws or dispatches, which
+/// the pipeline sets for all its passes at once (Pipeline::computePasses()).
+class ShadedPass {
+public:
+    /// Draws its fragment shaders or runs them as compute shaders.
+    void setStage(ShaderStage stage) { stage_ = stage; }
+    ShaderStage stage() const { return stage_; }
+
+protected:
+    /// defocus::shade() in this pass's stage.
+    void shade(const gl::Program& program, const gl::Framebuffer& target, const TileList* tiles = nullptr) const
+    {
+        defocus::shade(program, target, tiles, stage_);
+    }
+
+private:
+    ShaderStage stage_ = ShaderStage::Fragment;
+};
+
 } // namespace defocus

@@ -216,7 +216,7 @@ void RhombusBlurPass::run(const Io& io, bool first, const Directions& d, int tap
     if (io.nearDiameter)
         bindTexture(2, io.nearDiameter->id(), nearest_.id());
     shade(program(first, io.nearDiameter != nullptr, tiles != nullptr, mode1, mode2, mode3, taps, fused, unrolled),
-          io.target, tiles, stage_);
+          io.target, tiles);
 }
 
 } // namespace defocus

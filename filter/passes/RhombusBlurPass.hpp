@@ -14,7 +14,7 @@
 
 namespace defocus {
 
-class RhombusBlurPass {
+class RhombusBlurPass : public ShadedPass {
 public:
     /// Taps per line at most. Lines take one tap per pixel of their length up to `taps`;
     /// longer ones space `taps` taps out evenly.
@@ -77,9 +77,6 @@ public:
     void run(const Io& io, bool first, const Directions& directions, int taps, int tileSize,
              const TileList* tiles = nullptr, bool fused = false, bool unrolled = true);
 
-    /// Draws its fragment shaders or runs them as compute shaders (shade()).
-    void setStage(ShaderStage stage) { stage_ = stage; }
-
 private:
     /// Mirrors the std140 block RhombusBlurParams in rhombus_blur.frag.
     struct Uniforms {
@@ -107,7 +104,6 @@ private:
     gl::UniformBuffer uniforms_;
     gl::Sampler linear_;
     gl::Sampler nearest_;
-    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus

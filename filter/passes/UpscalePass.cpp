@@ -49,7 +49,7 @@ void UpscalePass::prefilter(const Io& io)
 {
     bindTexture(0, io.blurred.id(), nearest_.id());
     bindTexture(1, io.halfInput.id(), nearest_.id());
-    shade(prefilter_, io.prefiltered, nullptr, stage_);
+    shade(prefilter_, io.prefiltered);
 }
 
 void UpscalePass::upscale(const Io& io, const CocParams& params, int sizeShift, const TileList* detailTiles)
@@ -61,12 +61,12 @@ void UpscalePass::upscale(const Io& io, const CocParams& params, int sizeShift, 
     bindTexture(2, io.sharpened.id(), linear_.id());
     bindTexture(3, io.added.id(), linear_.id());
     if (!detailTiles) {
-        shade(programs.full, io.target, nullptr, stage_);
+        shade(programs.full, io.target);
         return;
     }
-    shade(programs.interpolateOnly, io.target, nullptr, stage_);
+    shade(programs.interpolateOnly, io.target);
     if (detailTiles->count() > 0)
-        shade(programs.detailTiles, io.target, detailTiles, stage_);
+        shade(programs.detailTiles, io.target, detailTiles);
 }
 
 } // namespace defocus

@@ -12,7 +12,7 @@
 
 namespace defocus {
 
-class UpscalePass {
+class UpscalePass : public ShadedPass {
 public:
     static constexpr const char* kName = "upscale";
     static constexpr const char* kPrefilterName = "prefilter";
@@ -44,9 +44,6 @@ public:
     /// quarter size.
     void upscale(const Io& io, const CocParams& params, int sizeShift, const TileList* detailTiles = nullptr);
 
-    /// Draws its fragment shaders or runs them as compute shaders (shade()).
-    void setStage(ShaderStage stage) { stage_ = stage; }
-
 private:
     struct Programs {
         gl::Program full;            ///< the detail, full screen
@@ -58,7 +55,6 @@ private:
     gl::Program prefilter_;
     gl::Sampler nearest_;
     gl::Sampler linear_;
-    ShaderStage stage_ = ShaderStage::Fragment;
 };
 
 } // namespace defocus
