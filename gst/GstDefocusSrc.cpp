@@ -136,16 +136,23 @@ GstBuffer* colorBuffer(const cv::Mat& bgr, const GstVideoInfo& info)
     return buffer;
 }
 
-/// Depth in metres as GRAY16_LE in `scale` units per metre, rounded; no measurement (0, NaN,
-/// negative) and beyond 65535 units stay 0 and 65535. No depth at all: zeros, which the filter
-/// reads as "no measurement", so the frame passes in focus as the command line passes it.
-GstBuffer* depthBuffer(const cv::Mat& metres, const GstVideoInfo& info, double scale)
+/// The frame's depth as GRAY16_LE in `scale` units per metre: 16-bit depth read at that scale as
+/// it is; otherwise from metres, rounded, where no measurement (0, NaN, negative) and beyond
+/// 65535 units stay 0 and 65535. No depth at all: zeros, which the filter reads as "no
+/// measurement", so the frame passes in focus as the command line passes it.
+GstBuffer* depthBuffer(const defocus::Frame& source, const GstVideoInfo& info, double scale)
 {
     GstBuffer* buffer = gst_buffer_new_allocate(nullptr, GST_VIDEO_INFO_SIZE(&info), nullptr);
     GstVideoFrame frame;
     gst_video_frame_map(&frame, &info, buffer, GST_MAP_WRITE);
     const int stride = GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 0);
     auto* data = static_cast<guint8*>(GST_VIDEO_FRAME_PLANE_DATA(&frame, 0));
+    if (source.depth.type() == CV_16UC1 && source.depthScale == scale && G_BYTE_ORDER == G_LITTLE_ENDIAN) {
+        source.depth.copyTo(cv::Mat(source.depth.size(), CV_16UC1, data, static_cast<std::size_t>(stride)));
+        gst_video_frame_unmap(&frame);
+        return buffer;
+    }
+    const cv::Mat metres = defocus::depthMetres(source);
     for (int y = 0; y < GST_VIDEO_INFO_HEIGHT(&info); ++y) {
         auto* row = reinterpret_cast<guint16*>(data + static_cast<std::ptrdiff_t>(y) * stride);
         for (int x = 0; x < GST_VIDEO_INFO_WIDTH(&info); ++x) {
@@ -288,7 +295,7 @@ void loop(gpointer data)
     }
 
     GstBuffer* color = colorBuffer(frame->color, st.colorInfo);
-    GstBuffer* depth = depthBuffer(frame->depth, st.depthInfo, scale);
+    GstBuffer* depth = depthBuffer(*frame, st.depthInfo, scale);
     for (GstBuffer* b : {color, depth}) {
         GST_BUFFER_PTS(b) = pts;
         GST_BUFFER_DURATION(b) = duration;
@@ -320,6 +327,7 @@ bool openSource(GstDefocusSrc* self)
         settings.depth = st.depthLocation;
         if (st.inputDepthScale > 0.0)
             settings.depthScale = st.inputDepthScale;
+        settings.depthUnits = true; // pushed as read where the scales agree
         settings.width = st.width;
         settings.height = st.height;
         settings.fps = st.fps;

@@ -91,6 +91,7 @@ Source::Source(const SourceSettings& settings) : impl_(std::make_unique<Impl>())
     if (!settings.depth.empty())
         options.depth = settings.depth;
     options.depthScale = settings.depthScale;
+    options.depthUnits = settings.depthUnits;
     options.width = settings.width;
     options.height = settings.height;
     options.fps = settings.fps;

@@ -154,8 +154,8 @@ FocusControl::FocusControl(const std::string& focus, std::optional<cv::Point2d> 
 double FocusControl::measure(const Frame& frame) const
 {
     if (point_)
-        return depthAtPoint(frame.depth, frame.color.size(), *point_).value_or(std::numeric_limits<double>::quiet_NaN());
-    return medianCentreDepth(frame.depth, 0.1).value_or(std::numeric_limits<double>::quiet_NaN());
+        return depthAtPoint(depthMetres(frame), frame.color.size(), *point_).value_or(std::numeric_limits<double>::quiet_NaN());
+    return medianCentreDepth(depthMetres(frame), 0.1).value_or(std::numeric_limits<double>::quiet_NaN());
 }
 
 double FocusControl::focusFor(const Frame& frame, double timeS, double dtS)
@@ -178,7 +178,7 @@ double FocusControl::focusFor(const Frame& frame, double timeS, double dtS)
                                static_cast<double>(size.width) / size.height);
         }
         tracking_ = true;
-        return autofocus_.update(frame.depth, dtS);
+        return autofocus_.update(depthMetres(frame), dtS);
     }
     return fixedM_;
 }

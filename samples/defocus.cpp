@@ -363,6 +363,8 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
 
     Settings settings = options.settings;
     settings.output = output;
+    if (options.depthScaleUsed > 0.0)
+        settings.depthScale = options.depthScaleUsed; // 16-bit depth goes to the filter as it was read
     Lens& lens = settings.lens; // its focus is set frame by frame
     bool settingsGiven = false; // given to the filter with the first frame's focus
     filter.reset();             // a new clip: frame 0 again
@@ -412,6 +414,11 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
         readbackMs += t.readbackMs;
         progress.update(++timed);
     };
+    // A frame's depth as the filter takes it: 16-bit depth as it was read, in the settings' units
+    // per metre (the filter converts it where it prepares depth); metres where the units differ.
+    const auto depthFor = [&](const Frame& frame) {
+        return frame.depthScale > 0.0 && frame.depthScale != settings.depthScale ? depthMetres(frame) : frame.depth;
+    };
     const auto receiveOne = [&] {
         const std::optional<cv::Mat> image = filter.receive();
         deliver(*image, waiting.front());
@@ -441,7 +448,7 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
                                                options.focusPoint, frame->color.cols, frame->color.rows,
                                                frame->color.cols - 1, frame->color.rows - 1));
             if (!depthChecked && !demo && options.depthScaleUsed > 0.0) {
-                const DepthScaleCheck check = checkDepthScale(frame->depth, options.depthScaleUsed, frame->name);
+                const DepthScaleCheck check = checkDepthScale(depthMetres(*frame), options.depthScaleUsed, frame->name);
                 depthChecked = check.validPixels > 0;
                 if (!check.warning.empty())
                     spdlog::warn("{}", check.warning);
@@ -470,12 +477,12 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
             const bool sheetFrame = !options.contactSheet.empty() && frame->index == options.contactFrame;
             if (sheetFrame || inFlight == 1) {
                 receiveAll();
-                const cv::Mat image = filter.process(frame->color, frame->depth, frame->timestampS);
+                const cv::Mat image = filter.process(frame->color, depthFor(*frame), frame->timestampS);
                 if (sheetFrame)
                     sheet = filter.contactSheet(); // written with the output, when the run is done
                 deliver(image, {std::move(*frame), lens.focusM});
             } else {
-                filter.submit(frame->color, frame->depth, frame->timestampS);
+                filter.submit(frame->color, depthFor(*frame), frame->timestampS);
                 waiting.push_back({std::move(*frame), lens.focusM});
                 if (filter.framesInFlight() >= inFlight)
                     receiveOne();
@@ -597,6 +604,7 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
         SourceOptions sourceOptions = options.camera;
         sourceOptions.input = options.input;
         sourceOptions.depthScale = options.depthScale;
+        sourceOptions.depthUnits = true;
         if (!options.depth.empty())
             sourceOptions.depth = options.depth;
         source = openSource(sourceOptions);

@@ -107,8 +107,11 @@ bool isImageName(const fs::path& name)
     return kImage.count(lowerExtension(name)) > 0 && !name.stem().empty();
 }
 
+constexpr double kTumUnitsPerMetre = 5000.0;
+
 // Depth in metres as TUM stores it: 16-bit, 5000 units per metre, 0 = no measurement; depths past
-// 13.1 m (the format's limit) are clamped to it.
+// 13.1 m (the format's limit) are clamped to it. 16-bit depth read at 5000 units is written as it
+// came.
 cv::Mat tumDepth(const cv::Mat& metres)
 {
     cv::Mat out(metres.size(), CV_16UC1);
@@ -117,7 +120,7 @@ cv::Mat tumDepth(const cv::Mat& metres)
             const float d = metres.at<float>(y, x);
             const bool valid = std::isfinite(d) && d > 0.0f;
             out.at<std::uint16_t>(y, x) =
-                valid ? static_cast<std::uint16_t>(std::min(65535.0f, std::round(d * 5000.0f))) : std::uint16_t{0};
+                valid ? static_cast<std::uint16_t>(std::min(65535.0f, std::round(d * static_cast<float>(kTumUnitsPerMetre)))) : std::uint16_t{0};
         }
     return out;
 }
@@ -175,11 +178,12 @@ void ImageSequenceSink::writeFrame(const cv::Mat& image, const Frame& origin)
                 stem + (linear_ ? ".exr" : ".png"), {}};
     const fs::path file = work_ / entry.color;
     checkFrame(image, encoding(), folder_ / entry.color);
-    if (!origin.depth.empty() && origin.depth.type() == CV_32FC1) {
+    const bool tumUnits = origin.depth.type() == CV_16UC1 && origin.depthScale == kTumUnitsPerMetre;
+    if (!origin.depth.empty() && (origin.depth.type() == CV_32FC1 || origin.depth.type() == CV_16UC1)) {
         entry.depth = "depth/" + stem + ".png";
         std::error_code ec;
         fs::create_directories(work_ / "depth", ec);
-        writeImageAtomically(work_ / entry.depth, tumDepth(origin.depth));
+        writeImageAtomically(work_ / entry.depth, tumUnits ? origin.depth : tumDepth(depthMetres(origin)));
     }
     writeImageAtomically(file, image);
     entries_.push_back(entry);

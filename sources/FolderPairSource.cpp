@@ -74,7 +74,7 @@ FolderPairSource::FolderPairSource(fs::path colorFolder, std::optional<fs::path>
                 "paired one to one by sorted name",
                 colorFolder_.string(), colorFiles_.size(), depth_->string(), depthFiles_.size()));
     } else {
-        sharedDepth_ = readDepth(*depth_, unitsPerMetre_);
+        sharedDepth_ = readStoredDepth(*depth_, unitsPerMetre_);
     }
 }
 
@@ -84,10 +84,13 @@ std::optional<Frame> FolderPairSource::next()
         return std::nullopt;
     Frame frame;
     frame.color = readColor(colorFiles_[next_]);
+    StoredDepth depth;
     if (!depthFiles_.empty())
-        frame.depth = readDepth(depthFiles_[next_], unitsPerMetre_);
-    else if (!sharedDepth_.empty())
-        frame.depth = sharedDepth_.clone(); // each frame owns its pixels
+        depth = readStoredDepth(depthFiles_[next_], unitsPerMetre_);
+    else if (!sharedDepth_.image.empty())
+        depth = {sharedDepth_.image.clone(), sharedDepth_.unitsPerMetre}; // each frame owns its pixels
+    frame.depth = depth.image;
+    frame.depthScale = depth.unitsPerMetre;
     if (!frame.depth.empty())
         checkDepthFits(frame.color.size(), colorFiles_[next_].string(), frame.depth.size(),
                        depthFiles_.empty() ? depth_->string() : depthFiles_[next_].string());

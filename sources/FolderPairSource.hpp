@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sources/FrameSource.hpp"
+#include "sources/ImageIO.hpp"
 
 namespace defocus {
 
@@ -34,7 +35,7 @@ private:
     double unitsPerMetre_;
     std::vector<std::filesystem::path> colorFiles_;
     std::vector<std::filesystem::path> depthFiles_; // empty unless depth_ is a folder
-    cv::Mat sharedDepth_;                           // set when depth_ is a single file
+    StoredDepth sharedDepth_;                       // set when depth_ is a single file
     std::size_t next_ = 0;
 };
 

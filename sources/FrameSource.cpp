@@ -39,7 +39,32 @@ double defaultDepthScale(const SourceOptions& options)
     return defaultUnitsPerMetre;
 }
 
-std::unique_ptr<FrameSource> openSource(const SourceOptions& options)
+namespace {
+
+/// A source's frames with their depth in metres (depthMetres()).
+class MetresSource final : public FrameSource {
+public:
+    explicit MetresSource(std::unique_ptr<FrameSource> source) : source_(std::move(source)) {}
+    std::optional<Frame> next() override
+    {
+        std::optional<Frame> frame = source_->next();
+        if (frame && frame->depthScale > 0.0) {
+            frame->depth = depthMetres(*frame);
+            frame->depthScale = 0.0;
+        }
+        return frame;
+    }
+    std::optional<std::size_t> frameCount() const override { return source_->frameCount(); }
+    double frameRate() const override { return source_->frameRate(); }
+    std::string describe() const override { return source_->describe(); }
+    bool isLive() const override { return source_->isLive(); }
+
+private:
+    std::unique_ptr<FrameSource> source_;
+};
+
+/// openSource() with the depth as stored.
+std::unique_ptr<FrameSource> openStoredSource(const SourceOptions& options)
 {
     const fs::path& input = options.input;
     if (input.empty())
@@ -84,6 +109,16 @@ std::unique_ptr<FrameSource> openSource(const SourceOptions& options)
     }
     throw SourceError(
         fmt::format("input '{}' is neither a folder nor a regular file", input.string()));
+}
+
+} // namespace
+
+std::unique_ptr<FrameSource> openSource(const SourceOptions& options)
+{
+    std::unique_ptr<FrameSource> source = openStoredSource(options);
+    if (options.depthUnits)
+        return source;
+    return std::make_unique<MetresSource>(std::move(source));
 }
 
 } // namespace defocus

@@ -73,6 +73,9 @@ struct SourceOptions {
     /// Units per metre of 16-bit depth images. Unset: 5000 for the TUM layout and a depth list
     /// (depth.txt), 1000 otherwise.
     std::optional<double> depthScale;
+    /// 16-bit depth comes as it was stored, CV_16UC1 with Frame::depthScale (what the filter
+    /// uploads as it is); otherwise as CV_32FC1 metres.
+    bool depthUnits = false;
     // ---- streams: `input` may also be a camera (/dev/video*), with `depth` a second
     // camera giving Z16 depth; a video file may take a depth folder or depth.txt (by index).
     /// Capture size asked of a camera, pixels (> 0); the driver picks the nearest it has.
@@ -91,7 +94,8 @@ struct SourceOptions {
 double defaultDepthScale(const SourceOptions& options);
 
 /// Opens the source that `options.input` names; throws SourceError with a clear message when
-/// it does not exist or cannot be recognised.
+/// it does not exist or cannot be recognised. Its frames' depth is metres unless
+/// `options.depthUnits`.
 std::unique_ptr<FrameSource> openSource(const SourceOptions& options);
 
 } // namespace defocus

@@ -180,26 +180,32 @@ void checkDepthScale(double unitsPerMetre, const std::string& name)
             name, unitsPerMetre));
 }
 
-cv::Mat depthFromRaw(const cv::Mat& raw, double unitsPerMetre, const std::string& name)
+StoredDepth storedDepthFromRaw(const cv::Mat& raw, double unitsPerMetre, const std::string& name)
 {
-    cv::Mat metres;
-    if (raw.depth() == CV_16U && raw.channels() == 1) {
-        // 0 (no measurement) stays 0.
-        raw.convertTo(metres, CV_32F, 1.0 / unitsPerMetre);
-        return metres;
-    }
+    if (raw.depth() == CV_16U && raw.channels() == 1)
+        return {raw, unitsPerMetre};
     if (isFloat(raw) && (raw.channels() == 1 || raw.channels() == 3 || raw.channels() == 4)) {
         // Renderers often store depth replicated in R, G and B: take the first channel.
         cv::Mat first = raw;
         if (raw.channels() > 1)
             cv::extractChannel(raw, first, 0);
+        cv::Mat metres;
         first.convertTo(metres, CV_32F);
-        return metres;
+        return {metres, 0.0};
     }
     throw SourceError(fmt::format(
         "cannot read depth image '{}': it is {}; expected 16-bit single-channel ({} units per "
         "metre) or float metres (EXR, TIFF)",
         name, describeSamples(raw), unitsPerMetre));
+}
+
+// 0 (no measurement) stays 0.
+cv::Mat metres(const StoredDepth& depth)
+{
+    Frame frame;
+    frame.depth = depth.image;
+    frame.depthScale = depth.unitsPerMetre;
+    return depthMetres(frame);
 }
 
 } // namespace
@@ -230,15 +236,20 @@ cv::Mat decodeDepth(std::span<const unsigned char> bytes, double unitsPerMetre, 
                     std::size_t maxPixels)
 {
     checkDepthScale(unitsPerMetre, name);
-    return depthFromRaw(decode(bytes, name, "depth", maxPixels, nullptr), unitsPerMetre, name);
+    return metres(storedDepthFromRaw(decode(bytes, name, "depth", maxPixels, nullptr), unitsPerMetre, name));
+}
+
+StoredDepth readStoredDepth(const fs::path& file, double unitsPerMetre)
+{
+    checkDepthScale(unitsPerMetre, file.string());
+    const std::vector<unsigned char> bytes = readBytes(file, "depth");
+    return storedDepthFromRaw(decode(bytes, file.string(), "depth", kMaxImagePixels, &file), unitsPerMetre,
+                              file.string());
 }
 
 cv::Mat readDepth(const fs::path& file, double unitsPerMetre)
 {
-    checkDepthScale(unitsPerMetre, file.string());
-    const std::vector<unsigned char> bytes = readBytes(file, "depth");
-    return depthFromRaw(decode(bytes, file.string(), "depth", kMaxImagePixels, &file), unitsPerMetre,
-                        file.string());
+    return metres(readStoredDepth(file, unitsPerMetre));
 }
 
 void checkDepthFits(const cv::Size& colorSize, const std::string& colorName, const cv::Size& depthSize,

@@ -35,6 +35,16 @@ cv::Mat readColor(const std::filesystem::path& file);
 cv::Mat decodeColor(std::span<const unsigned char> bytes, const std::string& name,
                     std::size_t maxPixels = kMaxImagePixels);
 
+/// A depth image as its file stored it: CV_16UC1 in `unitsPerMetre` units per metre, or CV_32FC1
+/// metres (float files; `unitsPerMetre` 0).
+struct StoredDepth {
+    cv::Mat image;
+    double unitsPerMetre = 0.0;
+};
+
+/// Reads a depth image as stored (readDepth() without the conversion to metres).
+StoredDepth readStoredDepth(const std::filesystem::path& file, double unitsPerMetre);
+
 /// Reads a depth image into CV_32FC1 metres. 16-bit integer images are divided by `unitsPerMetre`
 /// (0 stays 0 = no measurement); float EXR/TIFF are taken as metres. 8-bit or multi-channel
 /// images are rejected. Throws SourceError naming the file on failure.

@@ -54,13 +54,13 @@ double steadySeconds()
 // ---- StaticDepth ----
 
 StaticDepth::StaticDepth(fs::path file, double unitsPerMetre)
-    : file_(std::move(file)), depth_(readDepth(file_, unitsPerMetre))
+    : file_(std::move(file)), depth_(readStoredDepth(file_, unitsPerMetre))
 {
 }
 
 std::optional<DepthSample> StaticDepth::depthFor(const Frame&)
 {
-    return DepthSample{depth_.clone(), file_.string()}; // each frame owns its pixels
+    return DepthSample{{depth_.image.clone(), depth_.unitsPerMetre}, file_.string()}; // each frame owns its pixels
 }
 
 std::string StaticDepth::describe() const
@@ -181,10 +181,10 @@ std::optional<DepthSample> DepthSequence::depthFor(const Frame& color)
     if (!index)
         return std::nullopt;
     if (cachedIndex_ != index) {
-        cached_ = readDepth(entries_[*index].file, unitsPerMetre_);
+        cached_ = readStoredDepth(entries_[*index].file, unitsPerMetre_);
         cachedIndex_ = index;
     }
-    return DepthSample{cached_.clone(), entries_[*index].file.string()};
+    return DepthSample{{cached_.image.clone(), cached_.unitsPerMetre}, entries_[*index].file.string()};
 }
 
 std::string DepthSequence::describe() const
@@ -239,7 +239,7 @@ std::optional<DepthSample> V4l2DepthStream::depthFor(const Frame& color)
             best = it;
     if (best == recent_.end() || std::abs(best->timestampS - t) > maxGap_)
         return std::nullopt;
-    DepthSample sample{best->depth.clone(), best->name};
+    DepthSample sample{{best->depth.clone(), best->depthScale}, best->name};
     recent_.erase(recent_.begin(), best); // older ones are no nearer to any later colour frame
     return sample;
 }
@@ -270,10 +270,11 @@ std::optional<Frame> PairedSource::next()
     if (!frame)
         return std::nullopt;
     std::optional<DepthSample> depth = depth_->depthFor(*frame);
-    if (depth && !depth->metres.empty()) {
+    if (depth && !depth->depth.image.empty()) {
         if (!frame->color.empty())
-            checkDepthFits(frame->color.size(), frame->name, depth->metres.size(), depth->name);
-        frame->depth = std::move(depth->metres);
+            checkDepthFits(frame->color.size(), frame->name, depth->depth.image.size(), depth->name);
+        frame->depth = std::move(depth->depth.image);
+        frame->depthScale = depth->depth.unitsPerMetre;
     } else {
         frame->depth.release();
         if (unpaired_ == 0)

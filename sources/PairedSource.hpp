@@ -19,13 +19,14 @@
 #include <opencv2/core.hpp>
 
 #include "sources/FrameSource.hpp"
+#include "sources/ImageIO.hpp"
 #include "sources/V4l2Source.hpp"
 
 namespace defocus {
 
 /// One depth image handed to a colour frame.
 struct DepthSample {
-    cv::Mat metres;   ///< CV_32FC1, metres, its own size
+    StoredDepth depth; ///< as stored, its own size
     std::string name; ///< for messages, e.g. "depth/000012.png" or "video2#40"
 };
 
@@ -52,7 +53,7 @@ public:
 
 private:
     std::filesystem::path file_;
-    cv::Mat depth_;
+    StoredDepth depth_;
 };
 
 /// How a depth sequence is matched to colour frames.
@@ -106,7 +107,7 @@ private:
     std::string origin_;
     std::optional<double> firstColorTime_;
     std::optional<std::size_t> cachedIndex_;
-    cv::Mat cached_;
+    StoredDepth cached_;
 };
 
 /// Depth from a second, live V4L2 node (Z16), paired with each colour frame by capture time: the

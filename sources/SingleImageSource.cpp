@@ -20,7 +20,9 @@ SingleImageSource::SingleImageSource(std::filesystem::path colorFile,
     frame_.color = readColor(colorFile);
     frame_.name = colorFile.filename().string();
     if (depthFile) {
-        frame_.depth = readDepth(*depthFile, unitsPerMetre);
+        StoredDepth depth = readStoredDepth(*depthFile, unitsPerMetre);
+        frame_.depth = depth.image;
+        frame_.depthScale = depth.unitsPerMetre;
         checkDepthFits(frame_.color.size(), colorFile.string(), frame_.depth.size(),
                        depthFile->string());
         description_ = fmt::format("image '{}' + depth '{}'", colorFile.string(),

@@ -123,7 +123,9 @@ std::optional<Frame> TumSource::next()
     Frame frame;
     frame.color = readColor(folder_ / entry.rgb);
     if (entry.depth) {
-        frame.depth = readDepth(folder_ / *entry.depth, unitsPerMetre_);
+        StoredDepth depth = readStoredDepth(folder_ / *entry.depth, unitsPerMetre_);
+        frame.depth = depth.image;
+        frame.depthScale = depth.unitsPerMetre;
         checkDepthFits(frame.color.size(), (folder_ / entry.rgb).string(), frame.depth.size(),
                        (folder_ / *entry.depth).string());
     }

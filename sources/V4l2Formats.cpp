@@ -168,21 +168,13 @@ cv::Mat convertMjpeg(std::span<const std::uint8_t> data)
     }
 }
 
-cv::Mat convertZ16(std::span<const std::uint8_t> data, int width, int height,
-                   std::size_t bytesPerLine, double unitsPerMetre)
+cv::Mat convertZ16(std::span<const std::uint8_t> data, int width, int height, std::size_t bytesPerLine)
 {
     static_assert(std::endian::native == std::endian::little, "Z16 is little-endian");
-    if (!(unitsPerMetre > 0.0))
-        return {};
-    const cv::Mat z16 = view(data, height, width, CV_16UC1, strideFor(width, bytesPerLine, 2));
-    if (z16.empty())
-        return {};
-    cv::Mat metres;
-    z16.convertTo(metres, CV_32F, 1.0 / unitsPerMetre);
-    return metres;
+    return view(data, height, width, CV_16UC1, strideFor(width, bytesPerLine, 2)).clone();
 }
 
-cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout, double unitsPerMetre)
+cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout)
 {
     const int w = layout.width, h = layout.height;
     const std::size_t stride = layout.bytesPerLine;
@@ -200,7 +192,7 @@ cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout, d
     case V4L2_PIX_FMT_MJPEG:
         return convertMjpeg(data);
     case V4L2_PIX_FMT_Z16:
-        return convertZ16(data, w, h, stride, unitsPerMetre);
+        return convertZ16(data, w, h, stride);
     default:
         return {};
     }

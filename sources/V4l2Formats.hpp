@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Conversions of V4L2 pixel formats into what a Frame holds: colour formats to BGR CV_8UC3,
-// Z16 depth to metres. Pure functions on bytes, so tests check them without a camera.
+// Z16 depth as 16-bit units. Pure functions on bytes, so tests check them without a camera.
 #pragma once
 
 #include <cstddef>
@@ -60,14 +60,12 @@ cv::Mat convertGrey(std::span<const std::uint8_t> data, int width, int height,
 /// MJPG: one JPEG image decoded with cv::imdecode (trailing bytes after the end-of-image marker
 /// are ignored, so a buffer whose bytesused is the whole buffer still decodes).
 cv::Mat convertMjpeg(std::span<const std::uint8_t> data);
-/// Z16: little-endian 16-bit depth in `unitsPerMetre` units per metre, to CV_32FC1 metres;
-/// 0 (no measurement) stays 0.
-cv::Mat convertZ16(std::span<const std::uint8_t> data, int width, int height,
-                   std::size_t bytesPerLine, double unitsPerMetre);
+/// Z16: little-endian 16-bit depth, copied as it is into CV_16UC1 (the camera's units; 0 = no
+/// measurement).
+cv::Mat convertZ16(std::span<const std::uint8_t> data, int width, int height, std::size_t bytesPerLine);
 
-/// The conversion for `layout.fourcc`: colour formats give BGR CV_8UC3, Z16 gives metres. Empty
-/// for other formats, short data, or a JPEG that does not decode.
-cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout,
-                double unitsPerMetre);
+/// The conversion for `layout.fourcc`: colour formats give BGR CV_8UC3, Z16 its 16-bit units.
+/// Empty for other formats, short data, or a JPEG that does not decode.
+cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout);
 
 } // namespace defocus::v4l2

@@ -452,7 +452,7 @@ bool V4l2Source::dequeue(std::optional<Frame>& frame)
         if (layout_.fourcc != V4L2_PIX_FMT_MJPEG && used < v4l2::minimumFrameBytes(layout_))
             problem = fmt::format("{} bytes, a frame needs {}", used, v4l2::minimumFrameBytes(layout_));
         else
-            image = v4l2::convert(bytes, layout_, options_.unitsPerMetre);
+            image = v4l2::convert(bytes, layout_);
         if (image.empty() && problem.empty())
             problem = fmt::format("its {} data do not decode", v4l2::fourccName(layout_.fourcc));
     }
@@ -483,9 +483,10 @@ bool V4l2Source::dequeue(std::optional<Frame>& frame)
          (clock == V4L2_BUF_FLAG_TIMESTAMP_UNKNOWN && driverTime <= now + 1e-3 && driverTime > now - 1.0));
 
     frame.emplace();
-    if (options_.role == V4l2Options::Role::Depth)
+    if (options_.role == V4l2Options::Role::Depth) {
         frame->depth = std::move(image);
-    else
+        frame->depthScale = options_.unitsPerMetre;
+    } else
         frame->color = std::move(image);
     frame->timestampS = believable ? driverTime : now;
     frame->index = delivered_++;

@@ -48,7 +48,7 @@ VideoFileSource::VideoFileSource(std::filesystem::path file,
     // Without depthFile, the depth comes from elsewhere (PairedSource: a folder or depth.txt) or
     // there is none: openSource, which knows which, says so.
     if (depthFile_)
-        depth_ = readDepth(*depthFile_, unitsPerMetre);
+        depth_ = readStoredDepth(*depthFile_, unitsPerMetre);
 }
 
 std::optional<Frame> VideoFileSource::next()
@@ -82,10 +82,11 @@ std::optional<Frame> VideoFileSource::next()
     else
         throw SourceError(fmt::format("video '{}': frame {} has unsupported pixel type {}",
                                       file_.string(), next_, cv::typeToString(image.type())));
-    if (!depth_.empty()) {
+    if (!depth_.image.empty()) {
         checkDepthFits(frame.color.size(), fmt::format("{} frame {}", file_.string(), next_),
-                       depth_.size(), depthFile_->string());
-        frame.depth = depth_.clone(); // each frame owns its pixels
+                       depth_.image.size(), depthFile_->string());
+        frame.depth = depth_.image.clone(); // each frame owns its pixels
+        frame.depthScale = depth_.unitsPerMetre;
     }
     const double msec = capture_.get(cv::CAP_PROP_POS_MSEC);
     frame.timestampS = std::isfinite(msec) && msec >= 0.0 ? msec / 1000.0

@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "sources/FrameSource.hpp"
+#include "sources/ImageIO.hpp"
 
 namespace defocus {
 
@@ -36,7 +37,7 @@ private:
     std::filesystem::path file_;
     std::optional<std::filesystem::path> depthFile_;
     cv::VideoCapture capture_;
-    cv::Mat depth_;
+    StoredDepth depth_;
     double frameRate_ = 0.0;
     std::optional<std::size_t> frameCount_;
     std::size_t next_ = 0;

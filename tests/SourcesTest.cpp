@@ -359,6 +359,66 @@ TEST(OpenSource, DepthListScaleInAnyCase)
     EXPECT_EQ(defaultDepthScale({"clip.mp4", fs::path("takes") / "depth.png", std::nullopt}), 1000.0);
 }
 
+// Defects caught: a source that gives 16-bit depth without its scale, or with a scale other than
+// the one it reads at (TUM's 5000, 1000 elsewhere, --depth-scale); depth converted although the
+// caller asked for it as stored; float depth files given a scale; depth as stored not converted
+// to metres for a caller that did not ask for it.
+TEST(OpenSource, DepthAsStoredIsWhatTheMetresAreMadeFrom)
+{
+    const fs::path dir = test::scratchDir("OpenSource_units");
+    cv::Mat units(6, 8, CV_16UC1);
+    cv::randu(units, 0, 65536);
+    units.at<std::uint16_t>(2, 3) = 0; // no measurement
+    fs::create_directories(dir / "colour");
+    fs::create_directories(dir / "depth");
+    writeImage(dir / "colour" / "a.png", cv::Mat(6, 8, CV_8UC3, cv::Scalar(1, 2, 3)));
+    writeImage(dir / "colour" / "b.png", cv::Mat(6, 8, CV_8UC3, cv::Scalar(4, 5, 6)));
+    writeImage(dir / "depth" / "a.png", units);
+    writeImage(dir / "depth" / "b.png", 65535 - units);
+    writeImage(dir / "depth.png", units);
+    cv::Mat metresFile;
+    units.convertTo(metresFile, CV_32F, 1.0 / 1000.0);
+    enableOpenExr();
+    writeImage(dir / "depth.exr", metresFile);
+
+    struct Case {
+        const char* what;
+        SourceOptions options;
+        double scale; ///< units per metre the frames must carry; 0: float metres
+    };
+    const std::vector<Case> cases = {
+        {"TUM folder", {tumDir, std::nullopt, std::nullopt}, 5000.0},
+        {"TUM folder, --depth-scale", {tumDir, std::nullopt, 1000.0}, 1000.0},
+        {"folder pair", {dir / "colour", dir / "depth", std::nullopt}, 1000.0},
+        {"folder with one depth image", {dir / "colour", dir / "depth.png", 2000.0}, 2000.0},
+        {"one image", {dir / "colour" / "a.png", dir / "depth.png", std::nullopt}, 1000.0},
+        {"float depth", {dir / "colour" / "a.png", dir / "depth.exr", std::nullopt}, 0.0},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        SourceOptions stored = c.options;
+        stored.depthUnits = true;
+        const std::vector<Frame> asStored = readAll(*openSource(stored));
+        const std::vector<Frame> inMetres = readAll(*openSource(c.options));
+        ASSERT_EQ(asStored.size(), inMetres.size());
+        ASSERT_FALSE(asStored.empty());
+        for (std::size_t k = 0; k < asStored.size(); ++k) {
+            SCOPED_TRACE(k);
+            const Frame& a = asStored[k];
+            const Frame& m = inMetres[k];
+            ASSERT_EQ(a.depth.type(), c.scale > 0.0 ? CV_16UC1 : CV_32FC1);
+            EXPECT_EQ(a.depthScale, c.scale);
+            ASSERT_EQ(m.depth.type(), CV_32FC1);
+            EXPECT_EQ(m.depthScale, 0.0);
+            const cv::Mat converted = depthMetres(a);
+            ASSERT_EQ(converted.size(), m.depth.size());
+            EXPECT_EQ(cv::norm(converted, m.depth, cv::NORM_INF), 0.0) << "the same metres, bit for bit";
+            EXPECT_EQ(a.name, m.name);
+            EXPECT_EQ(a.timestampS, m.timestampS);
+        }
+    }
+}
+
 TEST(VideoFileSource, DecodesEveryFrameAndAppliesOneDepthImage)
 {
     const fs::path dir = test::scratchDir("VideoFile");

@@ -102,7 +102,7 @@ TEST(V4l2Formats, YuyvWithRowPadding)
     EXPECT_TRUE(v4l2::convertYuyv(std::span(data).first(23), 4, 2, 12).empty()) << "short data";
     EXPECT_TRUE(v4l2::convertYuyv(data, 3, 2, 12).empty()) << "odd width";
     // The dispatcher gives the same image.
-    const cv::Mat dispatched = v4l2::convert(data, {V4L2_PIX_FMT_YUYV, 4, 2, 12}, 1000.0);
+    const cv::Mat dispatched = v4l2::convert(data, {V4L2_PIX_FMT_YUYV, 4, 2, 12});
     EXPECT_EQ(cv::norm(dispatched, bgr, cv::NORM_INF), 0.0);
 }
 
@@ -148,7 +148,7 @@ TEST(V4l2Formats, Grey)
     EXPECT_EQ(at(bgr, 2, 0), cv::Vec3b(255, 255, 255));
 }
 
-TEST(V4l2Formats, Z16ToMetres)
+TEST(V4l2Formats, Z16KeepsItsUnitsWhichAFrameTurnsIntoMetres)
 {
     // 3x2 little-endian 16-bit values, stride 8 bytes (2 bytes of padding per row).
     const std::vector<std::uint16_t> values = {0, 1, 1000, 0xEEEE, 1500, 65535, 5000, 0xEEEE};
@@ -157,8 +157,16 @@ TEST(V4l2Formats, Z16ToMetres)
         data.push_back(static_cast<std::uint8_t>(v & 0xFF));
         data.push_back(static_cast<std::uint8_t>(v >> 8));
     }
-    const cv::Mat mm = v4l2::convertZ16(data, 3, 2, 8, 1000.0);
-    ASSERT_EQ(mm.size(), cv::Size(3, 2));
+    Frame frame;
+    frame.depth = v4l2::convertZ16(data, 3, 2, 8);
+    ASSERT_EQ(frame.depth.size(), cv::Size(3, 2));
+    ASSERT_EQ(frame.depth.type(), CV_16UC1);
+    EXPECT_EQ(frame.depth.at<std::uint16_t>(1, 1), 65535) << "little-endian, each row after its stride";
+    EXPECT_EQ(frame.depth.at<std::uint16_t>(1, 2), 5000);
+    data[2] = 7; // the camera's buffer goes back to the driver: the frame owns a copy
+    EXPECT_EQ(frame.depth.at<std::uint16_t>(0, 1), 1);
+    frame.depthScale = 1000.0;
+    const cv::Mat mm = depthMetres(frame);
     ASSERT_EQ(mm.type(), CV_32FC1);
     EXPECT_EQ(mm.at<float>(0, 0), 0.0f) << "0 stays 'no measurement'";
     EXPECT_FLOAT_EQ(mm.at<float>(0, 1), 0.001f);
@@ -166,10 +174,9 @@ TEST(V4l2Formats, Z16ToMetres)
     EXPECT_FLOAT_EQ(mm.at<float>(1, 0), 1.5f);
     EXPECT_FLOAT_EQ(mm.at<float>(1, 1), 65.535f);
     EXPECT_FLOAT_EQ(mm.at<float>(1, 2), 5.0f);
-    const cv::Mat tum = v4l2::convertZ16(data, 3, 2, 8, 5000.0);
-    EXPECT_FLOAT_EQ(tum.at<float>(1, 2), 1.0f);
-    EXPECT_TRUE(v4l2::convertZ16(data, 3, 2, 8, 0.0).empty()) << "scale must be positive";
-    EXPECT_TRUE(v4l2::convertZ16(std::span(data).first(15), 3, 2, 8, 1000.0).empty());
+    frame.depthScale = 5000.0;
+    EXPECT_FLOAT_EQ(depthMetres(frame).at<float>(1, 2), 1.0f);
+    EXPECT_TRUE(v4l2::convertZ16(std::span(data).first(15), 3, 2, 8).empty());
 }
 
 TEST(V4l2Formats, MjpegDecodesWithTrailingBytes)
@@ -384,7 +391,7 @@ TEST(PairedSource, DepthFolderPairsByTimestamp)
             continue;
         }
         ASSERT_FALSE(frames[k].depth.empty());
-        EXPECT_FLOAT_EQ(frames[k].depth.at<float>(0, 0), *want[k]);
+        EXPECT_FLOAT_EQ(depthMetres(frames[k]).at<float>(0, 0), *want[k]);
     }
     EXPECT_EQ(source.unpairedFrames(), 2u);
 
@@ -408,9 +415,9 @@ TEST(PairedSource, AlignedStartsPairAClipWithAbsoluteDepthTimes)
                         DepthSequence::fromFolder(dir / "depth", 1000.0, pairing));
     const std::vector<Frame> frames = readAll(source);
     ASSERT_EQ(frames.size(), 3u);
-    EXPECT_FLOAT_EQ(frames[0].depth.at<float>(0, 0), 0.1f);
-    EXPECT_FLOAT_EQ(frames[1].depth.at<float>(0, 0), 0.2f);
-    EXPECT_FLOAT_EQ(frames[2].depth.at<float>(0, 0), 0.3f);
+    EXPECT_FLOAT_EQ(depthMetres(frames[0]).at<float>(0, 0), 0.1f);
+    EXPECT_FLOAT_EQ(depthMetres(frames[1]).at<float>(0, 0), 0.2f);
+    EXPECT_FLOAT_EQ(depthMetres(frames[2]).at<float>(0, 0), 0.3f);
 }
 
 TEST(PairedSource, TumDepthListByTimestampMatchesTheBenchmarkAssociations)
@@ -440,7 +447,7 @@ TEST(PairedSource, TumDepthListByTimestampMatchesTheBenchmarkAssociations)
         const std::optional<DepthSample> sample = depth->depthFor(colour);
         ASSERT_TRUE(sample.has_value()) << k;
         EXPECT_EQ(sample->name, wantDepth[k]);
-        EXPECT_EQ(sample->metres.size(), cv::Size(640, 480));
+        EXPECT_EQ(sample->depth.image.size(), cv::Size(640, 480));
     }
 }
 

@@ -357,8 +357,9 @@ TEST(Loopback, Z16RoundTrips)
     for (const Frame& frame : frames) {
         ASSERT_TRUE(frame.color.empty());
         ASSERT_EQ(frame.depth.size(), cv::Size(w, h));
-        ASSERT_EQ(frame.depth.type(), CV_32FC1);
-        const int k = z16FrameNumber(frame.depth, 1000.0);
+        ASSERT_EQ(frame.depth.type(), CV_16UC1) << "Z16 as the camera gave it";
+        EXPECT_EQ(frame.depthScale, 1000.0);
+        const int k = z16FrameNumber(depthMetres(frame), 1000.0);
         EXPECT_GE(k, 0) << "captured depth is not exactly a produced frame";
         EXPECT_GT(k, previous) << "frames in order, none repeated";
         previous = k;

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// defocus::Frame: one RGB-D frame as a source gives it and the filter takes it: colour, depth in
-// metres, when it was captured and where it came from (for messages). defocus::Source gives
-// them; the command line's sources and sinks pass them along.
+// defocus::Frame: one RGB-D frame as a source gives it and the filter takes it: colour, depth (in
+// metres, or in the units a 16-bit file or camera stored), when it was captured and where it
+// came from (for messages). defocus::Source gives them; the command line's sources and sinks pass
+// them along.
 #pragma once
 
 #include <cstddef>
@@ -15,8 +16,11 @@ struct Frame {
     /// Colour, BGR channel order: CV_8UC3 sRGB-encoded, or CV_32FC3 scene-linear (EXR and other
     /// float inputs; values well above 1 are kept).
     cv::Mat color;
-    /// Depth along the view axis, metres, CV_32FC1, its own size (Filter::process resizes it to
-    /// the colour by nearest neighbour). 0, negative, NaN and infinities mean "no measurement".
+    /// Depth along the view axis, its own size (Filter::process resizes it to the colour by nearest
+    /// neighbour): CV_32FC1 metres, where 0, negative, NaN and infinities mean "no measurement";
+    /// or, from a Source with SourceSettings::depthUnits, CV_16UC1 as a 16-bit depth file or camera
+    /// stored it, `depthScale` units per metre, 0 = no measurement (what Filter::process uploads
+    /// as it is with Settings::depthScale the same). depthMetres() gives metres either way.
     /// Empty: no depth at all; the frame passes through in focus.
     cv::Mat depth;
     /// Capture time, seconds, on the source's clock (file names, TUM lists, a camera's
@@ -26,6 +30,20 @@ struct Frame {
     std::size_t index = 0;
     /// Where it came from, for messages, e.g. "rgb/1305031102.175304.png".
     std::string name;
+    /// Units per metre of CV_16UC1 `depth` (> 0); 0 where `depth` is metres or empty.
+    double depthScale = 0.0;
 };
+
+/// `frame.depth` as CV_32FC1 metres: 16-bit depth divided by its depthScale (0 stays 0), metres
+/// as they are (the same pixels, not a copy), empty as it is.
+inline cv::Mat depthMetres(const Frame& frame)
+{
+    if (frame.depth.type() != CV_16UC1 || frame.depth.empty())
+        return frame.depth;
+    CV_Assert(frame.depthScale > 0.0);
+    cv::Mat metres;
+    frame.depth.convertTo(metres, CV_32F, 1.0 / frame.depthScale);
+    return metres;
+}
 
 } // namespace defocus

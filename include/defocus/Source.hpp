@@ -60,6 +60,11 @@ struct SourceSettings {
     /// --depth-scale: units per metre of 16-bit depth images, > 0. Unset: 5000 for TUM folders
     /// and a TUM depth list, 1000 otherwise.
     std::optional<double> depthScale;
+    /// 16-bit depth (PNG files, Z16 cameras) comes as it was stored: CV_16UC1 with
+    /// Frame::depthScale its units per metre, for Filter::process to upload as it is (set
+    /// Settings::depthScale to the same; half the bytes of metres, converted where the depth is
+    /// prepared). Otherwise every frame's depth is CV_32FC1 metres.
+    bool depthUnits = false;
     /// A camera is asked for this size (pixels) and rate (Hz); it answers with the nearest it has.
     int width = 640;
     int height = 480;
