@@ -40,7 +40,8 @@ run() { # NAME MEMORY(gl|system): frames as NAME/%06d.png, each buffer's timesta
     defocus name=d depth-scale=5000 ! $down identity name=stamp silent=false ! videoconvert ! \
     video/x-raw,format=RGB ! pngenc ! multifilesink location="$work/$name/%06d.png" \
     s.color ! queue ! videoconvert ! video/x-raw,format=RGBA ! $up d.color \
-    s.depth ! queue ! $up d.depth >"$work/$name.log" 2>&1 || fail "$name: $(grep -m3 -i error "$work/$name.log")"
+    s.depth ! queue ! $up d.depth >"$work/$name.log" 2>&1 ||
+    fail "$name: gst-launch-1.0 exited $?: $(grep -m3 -i error "$work/$name.log"; grep -v 'last-message' "$work/$name.log" | tail -n 8)"
   grep -o 'stamp: last-message = chain.*' "$work/$name.log" | grep -o 'pts: [^,]*, duration: [^,]*' \
     >"$work/$name.ts" || true
 }
