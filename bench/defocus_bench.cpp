@@ -4,6 +4,7 @@
 //   defocus-bench                                    (run from the repository root)
 //   defocus-bench --sizes 640x480 --runs 30 --json out/bench.json
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -40,6 +41,7 @@
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
 #include "sources/FrameSource.hpp"
+#include "sources/ReadAheadSource.hpp"
 
 #include <unistd.h>
 
@@ -683,6 +685,75 @@ CLI::App* declareThroughput(CLI::App& app, defocus::ThroughputOptions& o)
     return sub;
 }
 
+/// `defocus-bench read`: what reading a recorded clip ahead of the filter costs per frame, as the
+/// command line reads it (depth as stored, ReadAheadSource), on 1..N threads.
+struct ReadOptions {
+    std::string input = "data/tum_fr1_rpy";
+    std::string depth;
+    std::optional<double> depthScale;
+    std::vector<std::size_t> threads{1, 2};
+    int passes = 3;
+};
+
+CLI::App* declareRead(CLI::App& app, ReadOptions& o)
+{
+    CLI::App* sub = app.add_subcommand("read", "Milliseconds per frame of reading a recorded clip as the command "
+                                               "line does (decoded ahead of the filter) on each number of threads, "
+                                               "passes interleaved, the files in the page cache; median of the passes "
+                                               "and its ratio to the first number's");
+    sub->add_option("INPUT", o.input, "What `defocus INPUT` takes: a TUM folder, a folder of images, ...")
+        ->capture_default_str();
+    sub->add_option("--depth", o.depth, "Its --depth");
+    sub->add_option("--depth-scale", o.depthScale, "Its --depth-scale");
+    sub->add_option("--threads", o.threads, "Reading threads, comma-separated")
+        ->delimiter(',')
+        ->check(cli::between(1, 64))
+        ->capture_default_str();
+    sub->add_option("--passes", o.passes, "Timed passes per number of threads, interleaved")
+        ->check(cli::between(1, 1000))
+        ->capture_default_str();
+    return sub;
+}
+
+int runRead(const ReadOptions& o)
+{
+    SourceOptions source;
+    source.input = o.input;
+    if (!o.depth.empty())
+        source.depth = o.depth;
+    source.depthScale = o.depthScale;
+    source.depthUnits = true;
+    // One pass unmeasured first: every number of threads then reads from the page cache.
+    const auto readAll = [&](std::size_t threads) {
+        const auto start = std::chrono::steady_clock::now();
+        ReadAheadSource ahead(openSource(source), threads + 1, threads);
+        std::size_t frames = 0;
+        while (ahead.next())
+            ++frames;
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        return std::pair{frames, ms / static_cast<double>(std::max<std::size_t>(frames, 1))};
+    };
+    const std::size_t frames = readAll(1).first;
+    std::vector<std::vector<double>> ms(o.threads.size());
+    for (int pass = 0; pass < o.passes; ++pass)
+        for (std::size_t i = 0; i < o.threads.size(); ++i)
+            ms[i].push_back(readAll(o.threads[i]).second);
+    std::printf("defocus-bench read: %s, %zu frames, %d passes, %u CPUs here, reading threads by default: %zu\n",
+                o.input.c_str(), frames, o.passes, std::thread::hardware_concurrency(),
+                ReadAheadSource::defaultThreads());
+    std::printf("%-8s %14s %10s\n", "threads", "ms per frame", "ratio");
+    double first = 0.0;
+    for (std::size_t i = 0; i < o.threads.size(); ++i) {
+        std::vector<double>& runs = ms[i];
+        std::nth_element(runs.begin(), runs.begin() + static_cast<std::ptrdiff_t>(runs.size() / 2), runs.end());
+        const double median = runs[runs.size() / 2];
+        if (i == 0)
+            first = median;
+        std::printf("%-8zu %14.2f %10.3f\n", o.threads[i], median, median / first);
+    }
+    return 0;
+}
+
 /// `defocus-bench accuracy ...` runs the accuracy sweep, built as its own program beside this one,
 /// with the arguments after the subcommand (its --help included).
 int runAccuracy(const std::vector<std::string>& rest, const char* self)
@@ -707,7 +778,7 @@ int main(int argc, char** argv)
     CLI::App app{"defocus-bench: milliseconds per pass and per frame of the defocus pipeline on the bundled TUM "
                  "clip, resized to each size; median and p90 of several runs, for a defocused and an all-in-focus "
                  "scene. Run it from the repository root. The subcommands time the per-frame plan (plan), hold the "
-                 "per-pass timing baseline (timing), time frames in flight against one at a time (throughput) and sweep accuracy against a path-traced lens (accuracy); "
+                 "per-pass timing baseline (timing), time frames in flight against one at a time (throughput), time reading a clip ahead of the filter (read) and sweep accuracy against a path-traced lens (accuracy); "
                  "each has its own --help."};
     defocus::cli::addVersionFlag(app, "defocus-bench");
     app.require_subcommand(0, 1);
@@ -717,6 +788,8 @@ int main(int argc, char** argv)
     CLI::App* plan = declarePlan(app, planOptions);
     defocus::ThroughputOptions throughputOptions;
     CLI::App* throughput = declareThroughput(app, throughputOptions);
+    ReadOptions readOptions;
+    CLI::App* read = declareRead(app, readOptions);
     CLI::App* accuracy = app.add_subcommand("accuracy", "Error against a path-traced thin lens and time per frame of "
                                                         "every method (defocus-bench-accuracy; 'accuracy --help' "
                                                         "lists its options)");
@@ -778,6 +851,8 @@ int main(int argc, char** argv)
             return defocus::runPlanComparison(planOptions);
         if (throughput->parsed())
             return defocus::runThroughput(throughputOptions);
+        if (read->parsed())
+            return runRead(readOptions);
         std::string commandLine = "defocus-bench";
         for (int i = 1; i < argc; ++i)
             commandLine += std::string(" ") + argv[i];

@@ -94,6 +94,7 @@ struct Options : cli::LensNames, cli::QualityNames {
     bool redo = false;
     std::string reportDir;
     std::size_t inFlight = 1;
+    std::size_t readThreads = 0; ///< --read-threads; 0 = ReadAheadSource::defaultThreads()
     std::optional<int> eglDevice;
     std::string report;        ///< --report FILE.json of a single run
 };
@@ -629,15 +630,19 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
     sinkOptions.overwrite = options.overwrite;
     sinkOptions.codec = options.codec;
     std::unique_ptr<FrameSink> sink = openSink(sinkOptions);
-    // While the filter works, a file output is encoded and written up to two frames behind and a
-    // recorded clip decoded up to two ahead, each on a thread of its own (docs/benchmarks.md,
-    // "Reading and writing beside the filter"); not a virtual camera's frames (due when made), nor
-    // --demo's (rendered on the GPU the filter uses, one call after the other).
+    // While the filter works, a file output is encoded and written up to two frames behind on a
+    // thread of its own, and a recorded clip decoded ahead on --read-threads threads, one frame
+    // more than threads ahead (docs/benchmarks.md, "Reading and writing beside the filter"); not a
+    // virtual camera's frames (due when made), nor --demo's (rendered on the GPU the filter uses,
+    // one call after the other).
     const bool virtualCamera = dynamic_cast<V4l2OutputSink*>(sink.get()) != nullptr;
     if (!virtualCamera)
         sink = std::make_unique<BackgroundSink>(std::move(sink));
-    if (!source->isLive() && !demo)
-        source = std::make_unique<ReadAheadSource>(std::move(source));
+    if (!source->isLive() && !demo) {
+        const std::size_t threads = options.readThreads > 0 ? options.readThreads : ReadAheadSource::defaultThreads();
+        source = std::make_unique<ReadAheadSource>(std::move(source), threads + 1, threads);
+        spdlog::debug("reading ahead on {} thread{}", threads, threads == 1 ? "" : "s");
+    }
     // A camera to a virtual camera: never make the camera wait, drop what the filter cannot keep up with.
     NewestFrameSource* newest = nullptr;
     if (source->isLive() && virtualCamera) {
@@ -745,6 +750,11 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_option("--report-dir", o.reportDir, "--batch: put the reports here [default: beside each output]");
     app.add_option("--in-flight", o.inFlight, "--batch: clips processed at once, a GL context each, 1..16")
         ->check(cli::between(1, 16))
+        ->capture_default_str();
+    app.add_option("--read-threads", o.readThreads,
+                   "Threads decoding a recorded clip ahead of the filter, 0..64; 0 = the CPUs this process may use "
+                   "less one, shared by the --in-flight clips, at most 8")
+        ->check(cli::between(0, 64))
         ->capture_default_str();
 }
 
@@ -916,6 +926,8 @@ int runBatchCommand(const Options& global, const std::vector<std::string>& argum
         }
         o.quiet = true;     // per-clip result lines only; no progress bars
         o.overwrite = true; // a clip without a report is the batch's to (re)write
+        if (o.readThreads == 0)
+            o.readThreads = ReadAheadSource::defaultThreads(global.inFlight); // the CPUs shared by the clips at once
         if (const auto status = finishOptions(app, o)) {
             spdlog::error("{}:{}: the clip's options are not valid (above)", global.batch, clip.line);
             return status;

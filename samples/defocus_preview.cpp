@@ -108,7 +108,8 @@ int run(const Options& o)
     const auto readAhead = [live](std::unique_ptr<FrameSource> opened) -> std::unique_ptr<FrameSource> {
         if (live)
             return opened;
-        return std::make_unique<ReadAheadSource>(std::move(opened));
+        const std::size_t threads = ReadAheadSource::defaultThreads();
+        return std::make_unique<ReadAheadSource>(std::move(opened), threads + 1, threads);
     };
     source = readAhead(std::move(source));
     const double sourceFps = source->frameRate() > 0.0 ? source->frameRate() : 30.0;

@@ -80,24 +80,36 @@ FolderPairSource::FolderPairSource(fs::path colorFolder, std::optional<fs::path>
 
 std::optional<Frame> FolderPairSource::next()
 {
+    const std::optional<Read> read = nextRead();
+    return read ? (*read)() : std::nullopt;
+}
+
+std::optional<FrameSource::Read> FolderPairSource::nextRead()
+{
     if (next_ >= colorFiles_.size())
         return std::nullopt;
-    Frame frame;
-    frame.color = readColor(colorFiles_[next_]);
-    StoredDepth depth;
-    if (!depthFiles_.empty())
-        depth = readStoredDepth(depthFiles_[next_], unitsPerMetre_);
-    else if (!sharedDepth_.image.empty())
-        depth = {sharedDepth_.image.clone(), sharedDepth_.unitsPerMetre}; // each frame owns its pixels
-    frame.depth = depth.image;
-    frame.depthScale = depth.unitsPerMetre;
-    if (!frame.depth.empty())
-        checkDepthFits(frame.color.size(), colorFiles_[next_].string(), frame.depth.size(),
-                       depthFiles_.empty() ? depth_->string() : depthFiles_[next_].string());
-    frame.index = next_;
-    frame.name = colorFiles_[next_].filename().string();
-    ++next_;
-    return frame;
+    const std::size_t index = next_++;
+    const std::optional<std::filesystem::path> depthFile =
+        !depthFiles_.empty() ? std::optional(depthFiles_[index]) : depth_;
+    // The one depth image for every frame is shared, read-only, with the reads (each frame gets
+    // its own copy of the pixels).
+    return [color = colorFiles_[index], depthFile, shared = sharedDepth_, perFrame = !depthFiles_.empty(), index,
+            unitsPerMetre = unitsPerMetre_] {
+        Frame frame;
+        frame.color = readColor(color);
+        StoredDepth depth;
+        if (perFrame)
+            depth = readStoredDepth(*depthFile, unitsPerMetre);
+        else if (!shared.image.empty())
+            depth = {shared.image.clone(), shared.unitsPerMetre};
+        frame.depth = depth.image;
+        frame.depthScale = depth.unitsPerMetre;
+        if (!frame.depth.empty())
+            checkDepthFits(frame.color.size(), color.string(), frame.depth.size(), depthFile->string());
+        frame.index = index;
+        frame.name = color.filename().string();
+        return std::optional<Frame>(std::move(frame));
+    };
 }
 
 std::optional<std::size_t> FolderPairSource::frameCount() const

@@ -26,6 +26,8 @@ public:
                      double unitsPerMetre);
 
     std::optional<Frame> next() override;
+    /// Each pair's files read and decoded on the thread that runs the read.
+    std::optional<Read> nextRead() override;
     std::optional<std::size_t> frameCount() const override;
     std::string describe() const override;
 

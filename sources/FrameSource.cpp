@@ -39,20 +39,27 @@ double defaultDepthScale(const SourceOptions& options)
     return defaultUnitsPerMetre;
 }
 
+std::optional<FrameSource::Read> FrameSource::nextRead()
+{
+    std::optional<Frame> frame = next();
+    if (!frame)
+        return std::nullopt;
+    return [frame = std::move(*frame)] { return std::optional<Frame>(frame); };
+}
+
 namespace {
 
 /// A source's frames with their depth in metres (depthMetres()).
 class MetresSource final : public FrameSource {
 public:
     explicit MetresSource(std::unique_ptr<FrameSource> source) : source_(std::move(source)) {}
-    std::optional<Frame> next() override
+    std::optional<Frame> next() override { return inMetres(source_->next()); }
+    std::optional<Read> nextRead() override
     {
-        std::optional<Frame> frame = source_->next();
-        if (frame && frame->depthScale > 0.0) {
-            frame->depth = depthMetres(*frame);
-            frame->depthScale = 0.0;
-        }
-        return frame;
+        std::optional<Read> read = source_->nextRead();
+        if (!read)
+            return std::nullopt;
+        return [read = std::move(*read)] { return inMetres(read()); };
     }
     std::optional<std::size_t> frameCount() const override { return source_->frameCount(); }
     double frameRate() const override { return source_->frameRate(); }
@@ -60,6 +67,15 @@ public:
     bool isLive() const override { return source_->isLive(); }
 
 private:
+    static std::optional<Frame> inMetres(std::optional<Frame> frame)
+    {
+        if (frame && frame->depthScale > 0.0) {
+            frame->depth = depthMetres(*frame);
+            frame->depthScale = 0.0;
+        }
+        return frame;
+    }
+
     std::unique_ptr<FrameSource> source_;
 };
 

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -52,6 +53,14 @@ public:
     /// The next frame, or nullopt at the end of the stream. Throws SourceError when a frame
     /// cannot be read; the stream may not be resumed after that.
     virtual std::optional<Frame> next() = 0;
+    /// The reading of one frame, which any thread may do: see nextRead().
+    using Read = std::function<std::optional<Frame>()>;
+    /// The next frame as work for another thread: the source takes its place in the stream at
+    /// once and returns what reads and decodes it (which may throw as next() does, and returns
+    /// the frame), so that ReadAheadSource decodes several frames at a time. nullopt at the end.
+    /// By default next() itself, done here: sources whose frames must be decoded one after the
+    /// other (videos, cameras, pairing by timestamp).
+    virtual std::optional<Read> nextRead();
     /// Number of frames, when known in advance (recorded clips).
     virtual std::optional<std::size_t> frameCount() const { return std::nullopt; }
     /// Nominal frame rate in Hz, used by video sinks; 0 when unknown.

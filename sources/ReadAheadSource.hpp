@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// A recorded source read ahead on a thread of its own: while the filter works on one frame, the
+// A recorded source read ahead on threads of its own: while the filter works on one frame, the
 // next ones are decoded (PNG decoding is single-threaded; at 1920x1080 a colour and a depth
-// frame take 70 ms). Frames and the source's error come out in the order the source gives them.
+// frame take 70 ms), several at a time where the source can hand its frames out as reads
+// (FrameSource::nextRead()). Frames and the source's error come out in the order the source
+// gives them.
 #pragma once
 
 #include <condition_variable>
@@ -13,6 +15,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "sources/FrameSource.hpp"
 
@@ -21,9 +24,10 @@ namespace defocus {
 class ReadAheadSource final : public FrameSource {
 public:
     /// Starts reading `source` (recorded, not live: a camera's frames are not to be queued) at
-    /// once, at most `depth` frames ahead of what next() has taken (>= 1).
-    explicit ReadAheadSource(std::unique_ptr<FrameSource> source, std::size_t depth = 2);
-    /// Stops the reading thread (after the frame it is reading).
+    /// once on `threads` threads (>= 1), at most `depth` frames ahead of what next() has taken
+    /// (>= 1; at least `threads`).
+    explicit ReadAheadSource(std::unique_ptr<FrameSource> source, std::size_t depth = 2, std::size_t threads = 1);
+    /// Stops the reading threads (after the frames they are reading).
     ~ReadAheadSource() override;
     ReadAheadSource(const ReadAheadSource&) = delete;
     ReadAheadSource& operator=(const ReadAheadSource&) = delete;
@@ -31,12 +35,23 @@ public:
     /// The next frame, waiting for it; nullopt at the end. Rethrows the source's error once the
     /// frames before it have been taken; after it, nullopt.
     std::optional<Frame> next() override;
-    // Asked of the source before the thread starts: a source need not answer them while it reads.
+    // Asked of the source before the threads start: a source need not answer them while it reads.
     std::optional<std::size_t> frameCount() const override { return frameCount_; }
     double frameRate() const override { return frameRate_; }
     std::string describe() const override { return describe_; }
 
+    /// Threads for decoding a recorded clip ahead of the filter, where `clips` clips run at once:
+    /// the CPUs this process may run on (its affinity: a Slurm job's or taskset's, not the
+    /// machine's) less one for the caller, shared among the clips, at most 8, at least one.
+    static std::size_t defaultThreads(std::size_t clips = 1);
+
 private:
+    /// One frame's place in the stream: read or not yet, its frame, or the error, or the end.
+    struct Slot {
+        bool done = false;
+        std::optional<Frame> frame; ///< nullopt with no error: the end of the stream
+        std::exception_ptr error;
+    };
     void read();
 
     std::unique_ptr<FrameSource> source_;
@@ -44,13 +59,14 @@ private:
     const std::optional<std::size_t> frameCount_;
     const double frameRate_;
     const std::string describe_;
-    std::mutex mutex_;
+    std::mutex sourceMutex_;    // one thread at a time asks the source for its next read
+    std::mutex mutex_;          // the slots and flags below
     std::condition_variable changed_;
-    std::deque<Frame> frames_;  // read, not yet taken
-    std::exception_ptr error_;  // after the frames in frames_
-    bool ended_ = false;        // the source ended or failed: nothing more comes after frames_
+    std::deque<Slot> slots_;    // from the next to take, in stream order
+    bool dispatchEnded_ = false; // the source said the end, or failed: no more slots
+    bool failed_ = false;       // next() has rethrown the error: nothing more comes out
     bool stopping_ = false;
-    std::thread thread_;        // last: starts once everything above is made
+    std::vector<std::thread> threads_; // last: start once everything above is made
 };
 
 } // namespace defocus

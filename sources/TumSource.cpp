@@ -117,23 +117,30 @@ void TumSource::pairByTimestamp(const fs::path& rgbList, const fs::path& depthLi
 
 std::optional<Frame> TumSource::next()
 {
+    const std::optional<Read> read = nextRead();
+    return read ? (*read)() : std::nullopt;
+}
+
+std::optional<FrameSource::Read> TumSource::nextRead()
+{
     if (next_ >= entries_.size())
         return std::nullopt;
-    const Entry& entry = entries_[next_];
-    Frame frame;
-    frame.color = readColor(folder_ / entry.rgb);
-    if (entry.depth) {
-        StoredDepth depth = readStoredDepth(folder_ / *entry.depth, unitsPerMetre_);
-        frame.depth = depth.image;
-        frame.depthScale = depth.unitsPerMetre;
-        checkDepthFits(frame.color.size(), (folder_ / entry.rgb).string(), frame.depth.size(),
-                       (folder_ / *entry.depth).string());
-    }
-    frame.timestampS = entry.rgbTime;
-    frame.index = next_;
-    frame.name = entry.rgb.generic_string();
-    ++next_;
-    return frame;
+    const std::size_t index = next_++;
+    return [entry = entries_[index], index, folder = folder_, unitsPerMetre = unitsPerMetre_] {
+        Frame frame;
+        frame.color = readColor(folder / entry.rgb);
+        if (entry.depth) {
+            StoredDepth depth = readStoredDepth(folder / *entry.depth, unitsPerMetre);
+            frame.depth = depth.image;
+            frame.depthScale = depth.unitsPerMetre;
+            checkDepthFits(frame.color.size(), (folder / entry.rgb).string(), frame.depth.size(),
+                           (folder / *entry.depth).string());
+        }
+        frame.timestampS = entry.rgbTime;
+        frame.index = index;
+        frame.name = entry.rgb.generic_string();
+        return std::optional<Frame>(std::move(frame));
+    };
 }
 
 std::optional<std::size_t> TumSource::frameCount() const

@@ -27,6 +27,8 @@ public:
     /// Throws SourceError naming the file for an unreadable image, or both files for a depth of
     /// another aspect ratio than its colour.
     std::optional<Frame> next() override;
+    /// Each frame's files read and decoded on the thread that runs the read.
+    std::optional<Read> nextRead() override;
     std::optional<std::size_t> frameCount() const override;
     double frameRate() const override;
     std::string describe() const override;

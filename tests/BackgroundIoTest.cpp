@@ -108,6 +108,87 @@ TEST(ReadAheadSource, ReadsAtMostItsDepthAhead)
     EXPECT_EQ(settled(3), 3u);
 }
 
+// Frames 0..count-1 handed out as reads that take a few milliseconds each, later frames often
+// sooner than earlier ones (so they finish out of order), counting the reads under way at once;
+// the read of frame `failAt` throws.
+class SlowReadsSource final : public FrameSource {
+public:
+    explicit SlowReadsSource(std::size_t count, std::optional<std::size_t> failAt = std::nullopt)
+        : count_(count), failAt_(failAt)
+    {
+    }
+    std::optional<Frame> next() override
+    {
+        const std::optional<Read> read = nextRead();
+        return read ? (*read)() : std::nullopt;
+    }
+    std::optional<Read> nextRead() override
+    {
+        if (handedOut >= count_)
+            return std::nullopt;
+        const std::size_t i = handedOut++;
+        return [this, i] {
+            const int now = ++underWay;
+            int most = mostUnderWay.load();
+            while (now > most && !mostUnderWay.compare_exchange_weak(most, now)) {
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(1 + (i * 7) % 6));
+            --underWay;
+            if (failAt_ && i == *failAt_)
+                throw SourceError("cannot read frame " + std::to_string(i));
+            Frame frame;
+            frame.color = cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(static_cast<double>(i)));
+            frame.index = i;
+            return std::optional<Frame>(frame);
+        };
+    }
+    std::string describe() const override { return "slow reads"; }
+    std::atomic<std::size_t> handedOut{0};
+    std::atomic<int> underWay{0};
+    std::atomic<int> mostUnderWay{0};
+
+private:
+    std::size_t count_;
+    std::optional<std::size_t> failAt_;
+};
+
+// Defects caught: frames given in the order their reads finished instead of the stream's; the
+// reads run one at a time although threads were asked for; more read ahead than the depth.
+TEST(ReadAheadSource, ReadsSideBySideGiveTheFramesInStreamOrder)
+{
+    auto slow = std::make_unique<SlowReadsSource>(60);
+    const SlowReadsSource& reads = *slow;
+    ReadAheadSource source(std::move(slow), 5, 4);
+    for (std::size_t i = 0; i < 60; ++i) {
+        const std::optional<Frame> frame = source.next();
+        ASSERT_TRUE(frame) << i;
+        EXPECT_EQ(frame->index, i);
+        EXPECT_LE(reads.handedOut.load(), i + 1 + 5) << "at most the depth ahead of what was taken";
+    }
+    EXPECT_FALSE(source.next());
+    EXPECT_FALSE(source.next());
+    EXPECT_GT(reads.mostUnderWay.load(), 1) << "the reads ran side by side";
+    EXPECT_LE(reads.mostUnderWay.load(), 4);
+}
+
+// Defects caught: a failed read's later frames (finished before it) given after the error, or
+// the frames before it lost; the error not rethrown; a reader stopped mid-stream that hangs.
+TEST(ReadAheadSource, AFailedReadComesAfterTheFramesBeforeItAndNothingAfter)
+{
+    ReadAheadSource source(std::make_unique<SlowReadsSource>(40, 9), 6, 3);
+    for (std::size_t i = 0; i < 9; ++i) {
+        const std::optional<Frame> frame = source.next();
+        ASSERT_TRUE(frame) << i;
+        EXPECT_EQ(frame->index, i);
+    }
+    EXPECT_THROW(source.next(), SourceError);
+    EXPECT_FALSE(source.next());
+
+    // Stopped with reads under way: the destructor waits for them and returns.
+    ReadAheadSource stopped(std::make_unique<SlowReadsSource>(1000), 8, 4);
+    ASSERT_TRUE(stopped.next());
+}
+
 // Records the value of each frame's pixel; throws on write number `failAt`; waits before each
 // write while `hold` is set.
 class RecordingSink final : public FrameSink {

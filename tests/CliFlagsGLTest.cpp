@@ -828,6 +828,35 @@ TEST_F(CliFlags, QuietVerboseAndVersion)
     EXPECT_EQ(version.out, "defocus " DEFOCUS_VERSION "\n");
 }
 
+// Defects caught: --read-threads not reaching the reading (the debug line names the threads it
+// read on), frames decoded side by side written in another order or changed, a value out of range
+// taken.
+TEST_F(CliFlags, ReadThreadsDecodeAheadAndTheFramesStayAsTheyWere)
+{
+    const std::string input =
+        fmt::format("'{}' --depth '{}' --focus 1 -y", file("clip/rgb").string(), file("clip/depth").string());
+    const fs::path oneOut = file("read_threads_1"), threeOut = file("read_threads_3");
+    const Ran one = defocus(input + " -v --read-threads 1 -o '" + oneOut.string() + "/'");
+    const Ran three = defocus(input + " -v --read-threads 3 -o '" + threeOut.string() + "/'");
+    ASSERT_EQ(one.exitCode, 0) << one.err;
+    ASSERT_EQ(three.exitCode, 0) << three.err;
+    EXPECT_NE(one.err.find("reading ahead on 1 thread\n"), std::string::npos) << one.err;
+    EXPECT_NE(three.err.find("reading ahead on 3 threads\n"), std::string::npos) << three.err;
+    std::size_t files = 0;
+    for (const auto& entry : fs::recursive_directory_iterator(oneOut)) {
+        if (!entry.is_regular_file())
+            continue;
+        ++files;
+        const fs::path same = threeOut / fs::relative(entry.path(), oneOut);
+        ASSERT_TRUE(fs::exists(same)) << same;
+        EXPECT_EQ(readText(entry.path()), readText(same)) << same;
+    }
+    EXPECT_GE(files, 4u) << "two frames, their depth and the lists";
+    const Ran bad = defocus(input + " --read-threads 65 -o '" + file("read_threads_bad").string() + "/'");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.err.find("--read-threads must be between 0 and 64"), std::string::npos) << bad.err;
+}
+
 // Defect: an option added to the command line with no test through the binary. Every option
 // --help lists is named here with the test that runs it; one missing from --help fails too.
 // Defect: --report not written, written before the clip is done, or counting frames wrongly (a
@@ -1052,6 +1081,7 @@ TEST_F(CliFlags, EveryOptionInTheHelpHasATest)
         {"--redo", "CliFlags.BatchReportDirInFlightAndRedo"},
         {"--report-dir", "CliFlags.BatchReportDirInFlightAndRedo"},
         {"--in-flight", "CliFlags.BatchReportDirInFlightAndRedo"},
+        {"--read-threads", "CliFlags.ReadThreadsDecodeAheadAndTheFramesStayAsTheyWere"},
         {"--progress-interval", "exit-status-test.sh (progress lines in a log)"},
     };
     const Ran help = defocus("--help");
