@@ -76,7 +76,11 @@ case ${1:-} in
       step "apertures-$size" scripts/aperture-cost.sh "$unpacked/bin" data/corpus/spheres-far-focus "$size" 20 3 ||
         echo "gpu-figures: apertures at $size not measured (see $out/apertures-$size.txt)"
     done
-    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, prep.txt, bench-prep.json, compute.txt, bench-compute.json, frame-*.exr, apertures-*.txt"
+    # Reading a 1080p clip ahead of the filter on 1 to 8 threads, and the command line's wall time
+    # with one reading thread and with its default (needs python3-opencv there to make the frames).
+    step read scripts/read-cost.sh "$unpacked/bin" 1920x1080 48 1,2,4,8 ||
+      echo "gpu-figures: reading not measured (see $out/read.txt)"
+    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, prep.txt, bench-prep.json, compute.txt, bench-compute.json, frame-*.exr, apertures-*.txt, read.txt"
     ;;
   *)
     echo "usage: scripts/gpu-figures.sh pack [BUILD_DIR] | run [OUT_DIR]" >&2
