@@ -112,13 +112,15 @@ int printInfo(const Options& options)
         fmt::print("EGL device {}: {}{}{}\n", d.index, d.software ? "software" : "hardware",
                    d.drmFile.empty() ? "" : ", " + d.drmFile, d.cudaId ? fmt::format(", CUDA device {}", *d.cudaId) : "");
     const RendererInfo info = probeRenderer(contextOptions(options));
+    const std::size_t cpus = ReadAheadSource::usableCpus();
+    const std::size_t threads = options.readThreads > 0 ? options.readThreads : ReadAheadSource::defaultThreads();
     fmt::print("EGL platform: {}{}\nEGL vendor:   {}\nEGL version:  {}\nGL vendor:    {}\nGL renderer:  {}\n"
                "GL version:   {}\nGPU timers:   {}\nDepth prep:   {}\nPrecision:    {} (the presets', the renderer's)\n"
-               "Passes:       {} shaders\n",
+               "Passes:       {} shaders\nReading:      {} thread{} ahead of the filter ({} CPU{} this process may use)\n",
                info.platform, info.eglDevice >= 0 ? fmt::format(" (EGL device {})", info.eglDevice) : "", info.eglVendor,
                info.eglVersion, info.glVendor, info.glRenderer, info.glVersion, info.timerQueries ? "yes" : "no",
                info.depthPrepOnGpu ? "GPU" : "CPU", info.halfFloatTargets ? "16f" : "32f",
-               info.computePasses ? "compute" : "fragment");
+               info.computePasses ? "compute" : "fragment", threads, threads == 1 ? "" : "s", cpus, cpus == 1 ? "" : "s");
     return kExitDone;
 }
 

@@ -33,13 +33,18 @@ ReadAheadSource::~ReadAheadSource()
         thread.join();
 }
 
-std::size_t ReadAheadSource::defaultThreads(std::size_t clips)
+std::size_t ReadAheadSource::usableCpus()
 {
     cpu_set_t allowed;
     CPU_ZERO(&allowed);
-    const std::size_t cpus = sched_getaffinity(0, sizeof allowed, &allowed) == 0
-                                 ? static_cast<std::size_t>(CPU_COUNT(&allowed))
-                                 : std::thread::hardware_concurrency();
+    if (sched_getaffinity(0, sizeof allowed, &allowed) == 0)
+        return static_cast<std::size_t>(CPU_COUNT(&allowed));
+    return std::max(std::thread::hardware_concurrency(), 1u);
+}
+
+std::size_t ReadAheadSource::defaultThreads(std::size_t clips)
+{
+    const std::size_t cpus = usableCpus();
     return std::clamp<std::size_t>((cpus > 1 ? cpus - 1 : 1) / std::max<std::size_t>(clips, 1), 1, 8);
 }
 

@@ -44,6 +44,9 @@ public:
     /// the CPUs this process may run on (its affinity: a Slurm job's or taskset's, not the
     /// machine's) less one for the caller, shared among the clips, at most 8, at least one.
     static std::size_t defaultThreads(std::size_t clips = 1);
+    /// The CPUs this process may run on: its affinity's count (hardware_concurrency() where the
+    /// affinity cannot be read).
+    static std::size_t usableCpus();
 
 private:
     /// One frame's place in the stream: read or not yet, its frame, or the error, or the end.

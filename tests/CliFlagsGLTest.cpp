@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <sched.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -811,6 +812,36 @@ TEST_F(CliFlags, InfoSaysWhereDepthPrepRunsAndThePresetsPrecision)
     EXPECT_NE(chosen.out.find(software ? "Depth prep:   GPU" : "Depth prep:   CPU"), std::string::npos) << chosen.out;
     EXPECT_NE(chosen.out.find(software ? "Passes:       compute" : "Passes:       fragment"), std::string::npos)
         << chosen.out;
+}
+
+// Defects caught: reading threads counted from the machine's CPUs, not the process's (a Slurm job
+// or taskset given one CPU of many would decode on threads it may not run), or --read-threads
+// not what --info says a run reads with.
+TEST_F(CliFlags, InfoSaysHowManyThreadsReadAheadOnTheCpusThisProcessMayUse)
+{
+    cpu_set_t mine;
+    CPU_ZERO(&mine);
+    ASSERT_EQ(sched_getaffinity(0, sizeof mine, &mine), 0);
+    const int cpus = CPU_COUNT(&mine);
+    const int expected = std::clamp(cpus - 1, 1, 8);
+    const Ran r = defocus("--info");
+    EXPECT_NE(r.out.find(fmt::format("Reading:      {} thread{} ahead of the filter ({} CPU{} this process may use)",
+                                     expected, expected == 1 ? "" : "s", cpus, cpus == 1 ? "" : "s")),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(defocus("--info --read-threads 5").out.find("Reading:      5 threads"), std::string::npos);
+    // One CPU of this process's (taskset, as a scheduler pins a job).
+    int first = 0;
+    while (!CPU_ISSET(first, &mine))
+        ++first;
+    const fs::path out = file("info_one_cpu.txt");
+    ASSERT_EQ(std::system(fmt::format("taskset -c {} '{}/defocus' --info >'{}' 2>&1", first, DEFOCUS_BINARY_DIR,
+                                      out.string())
+                              .c_str()),
+              0);
+    EXPECT_NE(readText(out).find("Reading:      1 thread ahead of the filter (1 CPU this process may use)"),
+              std::string::npos)
+        << readText(out);
 }
 
 // Defects: -q printing the log, -v not adding the debug lines, --version not the version.
