@@ -68,6 +68,8 @@ public:
     /// One line for logs of how the focus is chosen.
     std::string describe() const;
     bool isFixed() const { return mode_ == Mode::Fixed; }
+    /// focusFor() will read the next frame's depth: 'auto' until it has measured, 'track' always.
+    bool readsDepth() const { return mode_ == Mode::Track || (mode_ == Mode::Auto && !autoM_); }
 
 private:
     enum class Mode { Fixed, Auto, Track, Keyed };

@@ -450,6 +450,11 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
                 throw RequestError(fmt::format("--focus-point {} is outside the {}x{} frame (X 0 to {}, Y 0 to {})",
                                                options.focusPoint, frame->color.cols, frame->color.rows,
                                                frame->color.cols - 1, frame->color.rows - 1));
+            if (focus.readsDepth() && frame->depthScale > 0.0) {
+                // Metres once, for the focus and then the filter, not once for each.
+                frame->depth = depthMetres(*frame);
+                frame->depthScale = 0.0;
+            }
             if (!depthChecked && !demo && options.depthScaleUsed > 0.0) {
                 const DepthScaleCheck check = checkDepthScale(depthMetres(*frame), options.depthScaleUsed, frame->name);
                 depthChecked = check.validPixels > 0;

@@ -4,7 +4,6 @@
 #include "sources/ReadAheadSource.hpp"
 
 #include <algorithm>
-#include <iterator>
 #include <utility>
 
 #include <sched.h>
