@@ -52,12 +52,17 @@ void BackgroundSink::run()
                 error = std::current_exception();
             }
         }
+        // A sink that encodes frames side by side counts them once written, and names the
+        // frame whose write failed by the frames written before it.
+        const std::size_t written = failed ? 0 : sink_->framesWritten();
         lock.lock();
         if (error) {
             error_ = error;
-            failedFrame_ = written_;
+            failedFrame_ = written;
+            written_ = written;
         } else if (!failed) {
-            ++written_;
+            ++handed_;
+            written_ = written;
             describe_ = std::move(described);
         }
         changed_.notify_all();
@@ -111,6 +116,7 @@ fs::path BackgroundSink::abandon(bool keep)
         return {};
     fs::path kept = sink_->abandon(keep);
     const std::lock_guard lock(mutex_);
+    written_ = sink_->framesWritten();
     describe_ = sink_->describe();
     return kept;
 }
@@ -127,9 +133,19 @@ void BackgroundSink::finish()
         return;
     }
     lock.unlock();
+    try {
+        sink_->finish();
+    } catch (...) {
+        // Left to abandon(): a sink that encodes frames side by side finds a failed write here.
+        const std::lock_guard relock(mutex_);
+        written_ = sink_->framesWritten();
+        if (written_ < handed_)
+            failedFrame_ = written_;
+        throw;
+    }
     closed_ = true;
-    sink_->finish();
     lock.lock();
+    written_ = sink_->framesWritten();
     describe_ = sink_->describe();
 }
 

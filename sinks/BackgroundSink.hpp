@@ -35,7 +35,8 @@ public:
     void write(const cv::Mat& image) override;
     void writeFrame(const cv::Mat& image, const Frame& origin) override;
     /// Writes what is queued, then finalises the output. After a failed write it rethrows that
-    /// write's error (if not rethrown yet) and leaves the output to abandon(), unfinished.
+    /// write's error (if not rethrown yet) and leaves the output to abandon(), unfinished; so it
+    /// does when finalising fails.
     void finish() override;
     /// Writes what is queued (with `keep`; else drops it), then abandons the output. Rethrows an
     /// error of abandoning, not a write's (the caller that abandons has one of its own).
@@ -64,6 +65,7 @@ private:
     std::condition_variable changed_;
     std::deque<Job> jobs_;
     std::size_t written_ = 0; // frames written
+    std::size_t handed_ = 0;  // frames the sink took (a sink may write them later)
     std::string describe_;
     std::exception_ptr error_; // the failed write's, until rethrown
     std::optional<std::size_t> failedFrame_;

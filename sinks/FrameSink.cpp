@@ -123,7 +123,7 @@ std::unique_ptr<FrameSink> openSink(const SinkOptions& options)
     if (text.back() == '/' || fs::is_directory(output, ec)) {
         requireParentFolder(output, true);
         refuseExisting(output, options.overwrite);
-        return std::make_unique<ImageSequenceSink>(output, options.linearSequence, options.fps);
+        return std::make_unique<ImageSequenceSink>(output, options.linearSequence, options.fps, options.threads);
     }
     requireParentFolder(output, false);
     refuseExisting(output, options.overwrite);

@@ -93,6 +93,9 @@ struct SinkOptions {
     /// Video codec: "" = the container's default (.mp4 h264, .mkv ffv1, .webm vp9, .avi mjpg),
     /// or one of h264, mp4v, ffv1, vp9, mjpg.
     std::string codec;
+    /// For -o DIR/: frames encoded at once, on threads of the sink's own (>= 1; 1 = each frame
+    /// written in the call that gives it). Other outputs are written one frame after the other.
+    std::size_t threads = 1;
 };
 
 /// Picks the sink from the output path: a trailing '/' or an existing directory -> sequence;

@@ -127,7 +127,7 @@ cv::Mat tumDepth(const cv::Mat& metres)
 
 } // namespace
 
-ImageSequenceSink::ImageSequenceSink(fs::path folder, bool linear, double fps)
+ImageSequenceSink::ImageSequenceSink(fs::path folder, bool linear, double fps, std::size_t threads)
     : folder_(folder.has_filename() ? std::move(folder) : folder.parent_path()), linear_(linear), fps_(fps > 0.0 ? fps : 30.0)
 {
     // Beside a new folder, so that one rename puts it in place; inside one that exists (it may be
@@ -136,6 +136,14 @@ ImageSequenceSink::ImageSequenceSink(fs::path folder, bool linear, double fps)
     work_ = fs::is_directory(folder_, ec) ? folder_ / ".defocus.partial" : temporaryPath(folder_, true);
     fs::remove_all(work_, ec); // what a killed run left under this output's temporary name
     prepareFolder(work_, folder_);
+    if (linear_)
+        enableOpenExr(); // sets the environment: before any thread encodes
+    // One thread writes in the caller's call; more encode on threads of their own.
+    if (threads > 1) {
+        queueDepth_ = threads;
+        for (std::size_t i = 0; i < threads; ++i)
+            threads_.emplace_back([this] { encodeOnThread(); });
+    }
 }
 
 ImageSequenceSink::~ImageSequenceSink()
@@ -145,6 +153,7 @@ ImageSequenceSink::~ImageSequenceSink()
     } catch (const std::exception& e) {
         logger().error("{}", e.what());
     }
+    stopThreads(true); // where abandon() failed before it stopped them
 }
 
 SinkEncoding ImageSequenceSink::encoding() const
@@ -157,7 +166,7 @@ std::string ImageSequenceSink::nameFor(const Frame& origin)
     const fs::path name(origin.name);
     std::string stem = isImageName(name) ? name.stem().string() : std::string();
     if (stem.empty() || used_.count(stem) > 0)
-        stem = fmt::format("frame_{:06}", written_);
+        stem = fmt::format("frame_{:06}", entries_.size());
     used_.insert(stem);
     return stem;
 }
@@ -165,44 +174,162 @@ std::string ImageSequenceSink::nameFor(const Frame& origin)
 void ImageSequenceSink::write(const cv::Mat& image)
 {
     Frame origin;
-    origin.index = written_;
+    origin.index = entries_.size();
     writeFrame(image, origin);
+}
+
+void ImageSequenceSink::encode(const Job& job)
+{
+    if (!job.depthFile.empty()) {
+        const bool tumUnits = job.depth.depth.type() == CV_16UC1 && job.depth.depthScale == kTumUnitsPerMetre;
+        writeImageAtomically(job.depthFile, tumUnits ? job.depth.depth : tumDepth(depthMetres(job.depth)));
+    }
+    writeImageAtomically(job.colorFile, job.image);
+}
+
+void ImageSequenceSink::recordLocked(std::size_t position, std::exception_ptr error)
+{
+    if (error) {
+        if (!failedAt_ || position < *failedAt_) {
+            failedAt_ = position;
+            error_ = error;
+        }
+        return;
+    }
+    done_[position] = true;
+    while (written_ < done_.size() && done_[written_])
+        ++written_;
+}
+
+void ImageSequenceSink::encodeOnThread()
+{
+    std::unique_lock lock(mutex_);
+    for (;;) {
+        changed_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+        if (queue_.empty())
+            return; // stopping, and all written
+        Job job = std::move(queue_.front());
+        queue_.pop_front();
+        if (failedAt_ && job.position > *failedAt_)
+            continue; // after a failed write: nothing more is written
+        ++encoding_;
+        lock.unlock();
+        changed_.notify_all(); // room in the queue
+        std::exception_ptr error;
+        try {
+            encode(job);
+        } catch (...) {
+            error = std::current_exception();
+        }
+        const std::size_t position = job.position;
+        job = {}; // the frame's memory goes before the caller is told there is room
+        lock.lock();
+        --encoding_;
+        recordLocked(position, error);
+        changed_.notify_all();
+    }
+}
+
+void ImageSequenceSink::settle(std::unique_lock<std::mutex>& lock)
+{
+    changed_.wait(lock, [&] { return queue_.empty() && encoding_ == 0; });
+}
+
+void ImageSequenceSink::rethrowFailure(std::unique_lock<std::mutex>& lock)
+{
+    if (!failedAt_)
+        return;
+    // The frames before the failed one are written (or failed first) before its error comes.
+    settle(lock);
+    std::rethrow_exception(error_);
+}
+
+void ImageSequenceSink::stopThreads(bool drop)
+{
+    {
+        std::unique_lock lock(mutex_);
+        if (threads_.empty() || stopping_)
+            return;
+        if (drop)
+            queue_.clear();
+        stopping_ = true;
+    }
+    changed_.notify_all();
+    for (std::thread& thread : threads_)
+        thread.join();
 }
 
 void ImageSequenceSink::writeFrame(const cv::Mat& image, const Frame& origin)
 {
+    std::unique_lock lock(mutex_);
     if (finished_)
         throw SinkError(fmt::format("cannot write sequence '{}': already finished", folder_.string()));
+    rethrowFailure(lock);
+    const std::size_t position = entries_.size();
+    const double timestamp = origin.timestampS > 0.0 ? origin.timestampS : static_cast<double>(position) / fps_;
     const std::string stem = nameFor(origin);
-    Entry entry{origin.timestampS > 0.0 ? origin.timestampS : static_cast<double>(written_) / fps_,
-                stem + (linear_ ? ".exr" : ".png"), {}};
-    const fs::path file = work_ / entry.color;
-    checkFrame(image, encoding(), folder_ / entry.color);
-    const bool tumUnits = origin.depth.type() == CV_16UC1 && origin.depthScale == kTumUnitsPerMetre;
+    Entry entry{timestamp, stem + (linear_ ? ".exr" : ".png"), {}};
+    try {
+        checkFrame(image, encoding(), folder_ / entry.color);
+    } catch (...) {
+        settle(lock); // the frames before it are written when the caller hears of it
+        used_.erase(stem);
+        throw;
+    }
+    Job job{position, image, {}, work_ / entry.color, {}};
     if (!origin.depth.empty() && (origin.depth.type() == CV_32FC1 || origin.depth.type() == CV_16UC1)) {
         entry.depth = "depth/" + stem + ".png";
-        std::error_code ec;
-        fs::create_directories(work_ / "depth", ec);
-        writeImageAtomically(work_ / entry.depth, tumUnits ? origin.depth : tumDepth(depthMetres(origin)));
+        if (!std::exchange(depthFolder_, true)) {
+            std::error_code ec;
+            fs::create_directories(work_ / "depth", ec);
+        }
+        job.depth.depth = origin.depth;
+        job.depth.depthScale = origin.depthScale;
+        job.depthFile = work_ / entry.depth;
     }
-    writeImageAtomically(file, image);
-    entries_.push_back(entry);
-    ++written_;
+    entries_.push_back(std::move(entry));
+    done_.push_back(false);
+    if (threads_.empty()) {
+        lock.unlock();
+        std::exception_ptr error;
+        try {
+            encode(job);
+        } catch (...) {
+            error = std::current_exception();
+        }
+        lock.lock();
+        recordLocked(position, error);
+        rethrowFailure(lock);
+        return;
+    }
+    changed_.wait(lock, [&] { return queue_.size() < queueDepth_ || failedAt_; });
+    rethrowFailure(lock); // an earlier frame failed while this one waited: it is not written
+    queue_.push_back(std::move(job));
+    lock.unlock();
+    changed_.notify_all();
+}
+
+std::size_t ImageSequenceSink::framesWritten() const
+{
+    const std::lock_guard lock(mutex_);
+    return written_;
 }
 
 void ImageSequenceSink::writeLists() const
 {
+    // The frames written one after the other: none after a failed one.
+    const std::vector<Entry> entries(entries_.begin(), entries_.begin() + static_cast<std::ptrdiff_t>(written_));
     const auto list = [&](const char* what, auto line) {
         std::string text = fmt::format("# {}\n# file: written by defocus\n# timestamp {}\n", what,
                                        std::string(what) == "associations" ? "rgb timestamp depth" : "filename");
-        for (const Entry& e : entries_)
+        for (const Entry& e : entries)
             if (const std::string l = line(e); !l.empty())
                 text += l + "\n";
         return text;
     };
     writeFileAtomically(work_ / "rgb.txt",
                         list("color images", [](const Entry& e) { return fmt::format("{:.6f} {}", e.timestamp, e.color); }));
-    const bool anyDepth = std::any_of(entries_.begin(), entries_.end(), [](const Entry& e) { return !e.depth.empty(); });
+    const bool anyDepth = std::any_of(entries.begin(), entries.end(), [](const Entry& e) { return !e.depth.empty(); });
     if (!anyDepth)
         return;
     writeFileAtomically(work_ / "depth.txt", list("depth maps", [](const Entry& e) {
@@ -219,6 +346,12 @@ void ImageSequenceSink::finish()
 {
     if (finished_)
         return;
+    {
+        std::unique_lock lock(mutex_);
+        settle(lock);
+        rethrowFailure(lock); // unfinished: the caller abandons it
+    }
+    stopThreads(false);
     finished_ = true;
     std::error_code ec;
     if (written_ == 0) {
@@ -262,7 +395,15 @@ fs::path ImageSequenceSink::abandon(bool keep)
 {
     if (finished_)
         return {};
+    stopThreads(!keep);
     finished_ = true;
+    // What was written after a failed frame is not kept: the kept frames have no gap.
+    std::error_code ec;
+    for (std::size_t i = written_; keep && i < entries_.size(); ++i) {
+        fs::remove(work_ / entries_[i].color, ec);
+        if (!entries_[i].depth.empty())
+            fs::remove(work_ / entries_[i].depth, ec);
+    }
     if (keep && written_ > 0)
         writeLists();
     return keepOrRemove(work_, folder_, true, keep, written_, "sequence");
@@ -270,6 +411,7 @@ fs::path ImageSequenceSink::abandon(bool keep)
 
 std::string ImageSequenceSink::describe() const
 {
+    const std::lock_guard lock(mutex_);
     return fmt::format("{} sequence '{}' (TUM layout, {} frames)", linear_ ? "EXR" : "PNG", folder_.string(), written_);
 }
 

@@ -6,11 +6,19 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <vector>
+
+#include <chrono>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -18,7 +26,9 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "sinks/BackgroundSink.hpp"
 #include "sinks/FrameSink.hpp"
+#include "sinks/ImageSinks.hpp"
 #include "sources/ImageIO.hpp"
 #include "sources/FrameSource.hpp"
 #include "tests/TestSupport.hpp"
@@ -478,6 +488,195 @@ TEST(OpenSink, MakesOnlyTheLastFolderOfAFolderOutput)
     frames->write(testFrame(0));
     frames->finish();
     EXPECT_EQ(fileNames(dir / "frames"), (std::vector<std::string>{"frame_000000.png", "rgb.txt"}));
+}
+
+// The bytes of every regular file under `dir`, by path relative to it.
+std::map<std::string, std::string> filesUnder(const fs::path& dir)
+{
+    std::map<std::string, std::string> files;
+    for (const auto& entry : fs::recursive_directory_iterator(dir))
+        if (entry.is_regular_file()) {
+            std::ifstream in(entry.path(), std::ios::binary);
+            files[fs::relative(entry.path(), dir).string()] = {std::istreambuf_iterator<char>(in), {}};
+        }
+    return files;
+}
+
+// Frame k of a clip with everything a sequence output keeps: the input's name and timestamp,
+// depth in TUM's units, in another 16-bit scale, in metres, or none, and a name given twice.
+Frame clipFrame(int k)
+{
+    Frame origin;
+    origin.index = static_cast<std::size_t>(k);
+    origin.timestampS = 1305031102.0 + 0.033 * k;
+    origin.name = k == 5 ? "rgb/1305031102.099000.png" : fmt::format("rgb/{:.6f}.png", origin.timestampS);
+    const cv::Mat metres(48, 64, CV_32FC1, cv::Scalar(0.5 + 0.25 * k));
+    switch (k % 4) {
+    case 0: metres.convertTo(origin.depth, CV_16UC1, 5000.0); origin.depthScale = 5000.0; break;
+    case 1: metres.convertTo(origin.depth, CV_16UC1, 1000.0); origin.depthScale = 1000.0; break;
+    case 2: origin.depth = metres; break;
+    default: break; // no depth
+    }
+    return origin;
+}
+
+// Defects caught: frames encoded on several threads written under another frame's name or with
+// its depth (a job given the wrong frame), lists in the order the encodes finished, frames
+// without a name numbered by the frames written rather than by their place. The files and lists
+// of 3 threads are those of one, byte for byte.
+TEST(ImageSequenceSink, FramesEncodedSideBySideAreTheFilesOfOneAfterTheOther)
+{
+    const fs::path dir = test::scratchDir("Sink_sequence_threads");
+    for (const std::size_t threads : {1u, 3u}) {
+        ImageSequenceSink sink(dir / fmt::format("out{}", threads), false, 30.0, threads);
+        for (int k = 0; k < 12; ++k) {
+            // Larger frames take longer to encode: later frames may finish first.
+            const cv::Size size = k % 3 == 0 ? cv::Size(320, 240) : cv::Size(64, 48);
+            Frame origin = clipFrame(k);
+            if (size.width != 64 && !origin.depth.empty())
+                cv::resize(origin.depth, origin.depth, size, 0, 0, cv::INTER_NEAREST);
+            if (k == 7)
+                sink.write(testFrame(k, size)); // no input behind it: frame_000007
+            else
+                sink.writeFrame(testFrame(k, size), origin);
+        }
+        sink.finish();
+        EXPECT_EQ(sink.framesWritten(), 12u);
+    }
+    const auto one = filesUnder(dir / "out1"), three = filesUnder(dir / "out3");
+    EXPECT_EQ(one.size(), 12u + 9u + 3u) << "12 frames, 9 depth maps, 3 lists";
+    ASSERT_EQ(one.size(), three.size());
+    for (const auto& [name, bytes] : one) {
+        ASSERT_TRUE(three.count(name)) << name;
+        EXPECT_TRUE(three.at(name) == bytes) << name;
+    }
+    EXPECT_TRUE(one.count("frame_000007.png"));
+}
+
+// Defect caught: a folder's frames encoded one after the other whatever the threads (a thread
+// pool that is never used). Frame 0's file is a FIFO that nothing reads yet, so its encoding
+// waits; frame 1 is written meanwhile, yet counts as written only once frame 0 is.
+TEST(ImageSequenceSink, FramesAreEncodedSideBySide)
+{
+    const fs::path dir = test::scratchDir("Sink_sequence_side_by_side") / "out";
+    ImageSequenceSink sink(dir, false, 30.0, 2);
+    const fs::path work = temporaryPath(dir, true);
+    const fs::path fifo = work / ".frame_000000.partial.png";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    std::thread writer([&] {
+        sink.write(testFrame(0));
+        sink.write(testFrame(1));
+    });
+    bool second = false;
+    for (int i = 0; i < 1000 && !second; ++i) {
+        second = fs::exists(work / "frame_000001.png");
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    EXPECT_TRUE(second) << "frame 1 was not written while frame 0 waited";
+    EXPECT_EQ(sink.framesWritten(), 0u);
+    // Frame 0's encoding goes on once its bytes are read.
+    std::string bytes;
+    {
+        const int fd = ::open(fifo.c_str(), O_RDONLY);
+        ASSERT_GE(fd, 0);
+        char buffer[4096];
+        for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) > 0;)
+            bytes.append(buffer, static_cast<std::size_t>(n));
+        ::close(fd);
+    }
+    writer.join();
+    sink.finish();
+    EXPECT_EQ(sink.framesWritten(), 2u);
+    const cv::Mat first = cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(first.empty());
+    EXPECT_EQ(cv::norm(first, testFrame(0), cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(readBack(dir / "frame_000001.png"), testFrame(1), cv::NORM_INF), 0.0);
+}
+
+// Frames 0..7 into a sequence whose frame 2 cannot be written (a folder stands where its file
+// goes), the encoding of frame 2 held until frames 3 and 4 are written where threads allow (its
+// temporary file a FIFO read only then); returns what the first error said, counting the calls
+// that threw.
+struct FailedRun {
+    int thrown = 0;
+    std::size_t writtenAtFirstError = 0;
+};
+FailedRun writeAroundAFailure(FrameSink& sink, const fs::path& work, bool sideBySide)
+{
+    fs::create_directories(work / "frame_000002.png");
+    const fs::path fifo = work / ".frame_000002.partial.png";
+    EXPECT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    std::thread reader([&] {
+        for (int i = 0; sideBySide && i < 1000; ++i) {
+            if (fs::exists(work / "frame_000003.png") && fs::exists(work / "frame_000004.png"))
+                break;
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+        const int fd = ::open(fifo.c_str(), O_RDONLY);
+        char buffer[4096];
+        while (fd >= 0 && ::read(fd, buffer, sizeof buffer) > 0) {
+        }
+        ::close(fd);
+    });
+    FailedRun run;
+    for (int k = 0; k < 8; ++k) {
+        try {
+            sink.write(testFrame(k));
+        } catch (const SinkError&) {
+            if (run.thrown++ == 0)
+                run.writtenAtFirstError = sink.framesWritten();
+        }
+    }
+    try {
+        sink.finish();
+    } catch (const SinkError&) {
+        if (run.thrown++ == 0)
+            run.writtenAtFirstError = sink.framesWritten();
+    }
+    reader.join(); // frame 2 was encoded before finish() returned
+    if (sideBySide)
+        EXPECT_TRUE(fs::exists(work / "frame_000004.png")) << "frames 3 and 4 not written while frame 2 waited";
+    return run;
+}
+
+// Defects caught: frames written after a failed one (by other threads) counted as written, kept
+// in the partial output or listed there (a gap a reader cannot see), the output finalised after
+// a failed write, and a BackgroundSink naming a later frame than the one whose write failed
+// (counting the frames it handed on, not those written). One thread and three alike.
+TEST(ImageSequenceSink, AFailedWriteCountsTheFramesBeforeItAndKeepsNoneAfter)
+{
+    const fs::path base = test::scratchDir("Sink_sequence_failed");
+    for (const std::size_t threads : {1u, 3u}) {
+        for (const bool background : {false, true}) {
+            SCOPED_TRACE(fmt::format("{} threads{}", threads, background ? ", behind a BackgroundSink" : ""));
+            const fs::path dir = base / fmt::format("out{}{}", threads, background ? "b" : "");
+            auto sequence = std::make_unique<ImageSequenceSink>(dir, false, 30.0, threads);
+            std::unique_ptr<FrameSink> sink = std::move(sequence);
+            BackgroundSink* behind = nullptr;
+            if (background) {
+                auto wrapped = std::make_unique<BackgroundSink>(std::move(sink), 2);
+                behind = wrapped.get();
+                sink = std::move(wrapped);
+            }
+            const FailedRun run = writeAroundAFailure(*sink, temporaryPath(dir, true), threads > 1);
+            EXPECT_GE(run.thrown, 1);
+            if (!background)
+                EXPECT_EQ(run.writtenAtFirstError, 2u);
+            else
+                EXPECT_EQ(behind->failedFrame(), std::optional<std::size_t>(2));
+            EXPECT_EQ(sink->framesWritten(), 2u);
+            EXPECT_FALSE(fs::exists(dir)) << "a failed run's output under its final name";
+            const fs::path kept = sink->abandon(true);
+            ASSERT_EQ(kept, partialPath(dir, true));
+            std::vector<std::string> files;
+            for (const auto& [name, bytes] : filesUnder(kept))
+                files.push_back(name);
+            EXPECT_EQ(files, (std::vector<std::string>{"frame_000000.png", "frame_000001.png", "rgb.txt"}));
+            std::ifstream list(kept / "rgb.txt");
+            const std::string text{std::istreambuf_iterator<char>(list), {}};
+            EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 3 + 2) << text; // header and two frames
+        }
+    }
 }
 
 } // namespace
