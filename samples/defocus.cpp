@@ -95,6 +95,7 @@ struct Options : cli::LensNames, cli::QualityNames {
     std::string reportDir;
     std::size_t inFlight = 1;
     std::size_t readThreads = 0; ///< --read-threads; 0 = ReadAheadSource::defaultThreads()
+    std::size_t writeThreads = 0; ///< --write-threads; 0 = the same default
     std::optional<int> eglDevice;
     std::string report;        ///< --report FILE.json of a single run
 };
@@ -114,13 +115,16 @@ int printInfo(const Options& options)
     const RendererInfo info = probeRenderer(contextOptions(options));
     const std::size_t cpus = ReadAheadSource::usableCpus();
     const std::size_t threads = options.readThreads > 0 ? options.readThreads : ReadAheadSource::defaultThreads();
+    const std::size_t writing = options.writeThreads > 0 ? options.writeThreads : ReadAheadSource::defaultThreads();
     fmt::print("EGL platform: {}{}\nEGL vendor:   {}\nEGL version:  {}\nGL vendor:    {}\nGL renderer:  {}\n"
                "GL version:   {}\nGPU timers:   {}\nDepth prep:   {}\nPrecision:    {} (the presets', the renderer's)\n"
-               "Passes:       {} shaders\nReading:      {} thread{} ahead of the filter ({} CPU{} this process may use)\n",
+               "Passes:       {} shaders\nReading:      {} thread{} ahead of the filter ({} CPU{} this process may use)\n"
+               "Writing:      {} thread{} encoding a folder output's frames behind the filter\n",
                info.platform, info.eglDevice >= 0 ? fmt::format(" (EGL device {})", info.eglDevice) : "", info.eglVendor,
                info.eglVersion, info.glVendor, info.glRenderer, info.glVersion, info.timerQueries ? "yes" : "no",
                info.depthPrepOnGpu ? "GPU" : "CPU", info.halfFloatTargets ? "16f" : "32f",
-               info.computePasses ? "compute" : "fragment", threads, threads == 1 ? "" : "s", cpus, cpus == 1 ? "" : "s");
+               info.computePasses ? "compute" : "fragment", threads, threads == 1 ? "" : "s", cpus, cpus == 1 ? "" : "s",
+               writing, writing == 1 ? "" : "s");
     return kExitDone;
 }
 
@@ -636,10 +640,14 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
     sinkOptions.linearSequence = options.imageFormat == "exr";
     sinkOptions.overwrite = options.overwrite;
     sinkOptions.codec = options.codec;
+    sinkOptions.threads = options.writeThreads > 0 ? options.writeThreads : ReadAheadSource::defaultThreads();
     std::unique_ptr<FrameSink> sink = openSink(sinkOptions);
+    if (const auto* sequence = dynamic_cast<ImageSequenceSink*>(sink.get()))
+        spdlog::debug("encoding the frames on {} thread{}", sequence->threads(), sequence->threads() == 1 ? "" : "s");
     // While the filter works, a file output is encoded and written up to two frames behind on a
-    // thread of its own, and a recorded clip decoded ahead on --read-threads threads, one frame
-    // more than threads ahead (docs/benchmarks.md, "Reading and writing beside the filter"); not a
+    // thread of its own (a folder's frames side by side on --write-threads threads behind it),
+    // and a recorded clip decoded ahead on --read-threads threads, one frame more than threads
+    // ahead (docs/benchmarks.md, "Reading and writing beside the filter"); not a
     // virtual camera's frames (due when made), nor --demo's (rendered on the GPU the filter uses,
     // one call after the other).
     const bool virtualCamera = dynamic_cast<V4l2OutputSink*>(sink.get()) != nullptr;
@@ -761,6 +769,11 @@ void declareOptions(CLI::App& app, Options& o)
     app.add_option("--read-threads", o.readThreads,
                    "Threads decoding a recorded clip ahead of the filter, 0..64; 0 = the CPUs this process may use "
                    "less one, shared by the --in-flight clips, at most 8")
+        ->check(cli::between(0, 64))
+        ->capture_default_str();
+    app.add_option("--write-threads", o.writeThreads,
+                   "Threads encoding the frames of a folder output (DIR/) side by side, 0..64; 0 = as "
+                   "--read-threads' 0")
         ->check(cli::between(0, 64))
         ->capture_default_str();
 }
@@ -935,6 +948,8 @@ int runBatchCommand(const Options& global, const std::vector<std::string>& argum
         o.overwrite = true; // a clip without a report is the batch's to (re)write
         if (o.readThreads == 0)
             o.readThreads = ReadAheadSource::defaultThreads(global.inFlight); // the CPUs shared by the clips at once
+        if (o.writeThreads == 0)
+            o.writeThreads = ReadAheadSource::defaultThreads(global.inFlight);
         if (const auto status = finishOptions(app, o)) {
             spdlog::error("{}:{}: the clip's options are not valid (above)", global.batch, clip.line);
             return status;

@@ -817,7 +817,7 @@ TEST_F(CliFlags, InfoSaysWhereDepthPrepRunsAndThePresetsPrecision)
 // Defects caught: reading threads counted from the machine's CPUs, not the process's (a Slurm job
 // or taskset given one CPU of many would decode on threads it may not run), or --read-threads
 // not what --info says a run reads with.
-TEST_F(CliFlags, InfoSaysHowManyThreadsReadAheadOnTheCpusThisProcessMayUse)
+TEST_F(CliFlags, InfoSaysHowManyThreadsReadAndWriteOnTheCpusThisProcessMayUse)
 {
     cpu_set_t mine;
     CPU_ZERO(&mine);
@@ -829,7 +829,12 @@ TEST_F(CliFlags, InfoSaysHowManyThreadsReadAheadOnTheCpusThisProcessMayUse)
                                      expected, expected == 1 ? "" : "s", cpus, cpus == 1 ? "" : "s")),
               std::string::npos)
         << r.out;
+    EXPECT_NE(r.out.find(fmt::format("Writing:      {} thread{} encoding a folder output's frames", expected,
+                                     expected == 1 ? "" : "s")),
+              std::string::npos)
+        << r.out;
     EXPECT_NE(defocus("--info --read-threads 5").out.find("Reading:      5 threads"), std::string::npos);
+    EXPECT_NE(defocus("--info --write-threads 6").out.find("Writing:      6 threads"), std::string::npos);
     // One CPU of this process's (taskset, as a scheduler pins a job).
     int first = 0;
     while (!CPU_ISSET(first, &mine))
@@ -886,6 +891,35 @@ TEST_F(CliFlags, ReadThreadsDecodeAheadAndTheFramesStayAsTheyWere)
     const Ran bad = defocus(input + " --read-threads 65 -o '" + file("read_threads_bad").string() + "/'");
     EXPECT_EQ(bad.exitCode, 2);
     EXPECT_NE(bad.err.find("--read-threads must be between 0 and 64"), std::string::npos) << bad.err;
+}
+
+// Defects caught: --write-threads not reaching a folder output (the debug line names the threads
+// it encodes on), frames encoded side by side written under other names, changed or listed in
+// another order, a value out of range taken.
+TEST_F(CliFlags, WriteThreadsEncodeAFoldersFramesAndTheFilesStayAsTheyWere)
+{
+    const std::string input =
+        fmt::format("'{}' --depth '{}' --focus 1 -y", file("clip/rgb").string(), file("clip/depth").string());
+    const fs::path oneOut = file("write_threads_1"), threeOut = file("write_threads_3");
+    const Ran one = defocus(input + " -v --write-threads 1 -o '" + oneOut.string() + "/'");
+    const Ran three = defocus(input + " -v --write-threads 3 -o '" + threeOut.string() + "/'");
+    ASSERT_EQ(one.exitCode, 0) << one.err;
+    ASSERT_EQ(three.exitCode, 0) << three.err;
+    EXPECT_NE(one.err.find("encoding the frames on 1 thread\n"), std::string::npos) << one.err;
+    EXPECT_NE(three.err.find("encoding the frames on 3 threads\n"), std::string::npos) << three.err;
+    std::size_t files = 0;
+    for (const auto& entry : fs::recursive_directory_iterator(oneOut)) {
+        if (!entry.is_regular_file())
+            continue;
+        ++files;
+        const fs::path same = threeOut / fs::relative(entry.path(), oneOut);
+        ASSERT_TRUE(fs::exists(same)) << same;
+        EXPECT_EQ(readText(entry.path()), readText(same)) << same;
+    }
+    EXPECT_GE(files, 4u) << "two frames, their depth and the lists";
+    const Ran bad = defocus(input + " --write-threads 65 -o '" + file("write_threads_bad").string() + "/'");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.err.find("--write-threads must be between 0 and 64"), std::string::npos) << bad.err;
 }
 
 // Defect: an option added to the command line with no test through the binary. Every option
@@ -1113,6 +1147,7 @@ TEST_F(CliFlags, EveryOptionInTheHelpHasATest)
         {"--report-dir", "CliFlags.BatchReportDirInFlightAndRedo"},
         {"--in-flight", "CliFlags.BatchReportDirInFlightAndRedo"},
         {"--read-threads", "CliFlags.ReadThreadsDecodeAheadAndTheFramesStayAsTheyWere"},
+        {"--write-threads", "CliFlags.WriteThreadsEncodeAFoldersFramesAndTheFilesStayAsTheyWere"},
         {"--progress-interval", "exit-status-test.sh (progress lines in a log)"},
     };
     const Ran help = defocus("--help");
