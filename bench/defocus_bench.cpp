@@ -40,6 +40,8 @@
 #include "samples/BenchMachine.hpp"
 #include "samples/CliOptions.hpp"
 #include "samples/ExitStatus.hpp"
+#include "sinks/BackgroundSink.hpp"
+#include "sinks/FrameSink.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/ReadAheadSource.hpp"
 
@@ -754,6 +756,95 @@ int runRead(const ReadOptions& o)
     return 0;
 }
 
+/// `defocus-bench write`: what writing a folder output (DIR/, PNG in the TUM layout) costs per
+/// frame, as the command line writes it (a BackgroundSink over the sequence), on 1..N threads.
+struct WriteOptions {
+    std::string input = "data/tum_fr1_rpy";
+    std::string size;
+    std::size_t frames = 24;
+    std::vector<std::size_t> threads{1, 2};
+    int passes = 3;
+};
+
+CLI::App* declareWrite(CLI::App& app, WriteOptions& o)
+{
+    CLI::App* sub = app.add_subcommand("write", "Milliseconds per frame of writing a folder output (PNG colour and "
+                                                "16-bit depth, the TUM layout) as the command line does, from the "
+                                                "filter's call to the finished folder, on each number of encoding "
+                                                "threads, passes interleaved, into the system's temporary folder; "
+                                                "median of the passes and its ratio to the first number's");
+    sub->add_option("INPUT", o.input, "A TUM folder whose frames (repeated as needed) are written")->capture_default_str();
+    sub->add_option("--size", o.size, "Frame size WIDTHxHEIGHT [default: the clip's]");
+    sub->add_option("--frames", o.frames, "Frames per pass")->check(cli::between(1, 100000))->capture_default_str();
+    sub->add_option("--threads", o.threads, "Encoding threads, comma-separated")
+        ->delimiter(',')
+        ->check(cli::between(1, 64))
+        ->capture_default_str();
+    sub->add_option("--passes", o.passes, "Timed passes per number of threads, interleaved")
+        ->check(cli::between(1, 1000))
+        ->capture_default_str();
+    return sub;
+}
+
+int runWrite(const WriteOptions& o)
+{
+    SourceOptions source;
+    source.input = o.input;
+    source.depthUnits = true; // as the command line passes depth on: 16-bit, as stored
+    std::vector<Frame> clip;
+    for (auto frames = openSource(source); auto frame = frames->next();)
+        clip.push_back(std::move(*frame));
+    if (clip.empty())
+        throw std::runtime_error(fmt::format("{} gave no frames", o.input));
+    if (!o.size.empty())
+        clip = resizeClip(clip, parseSize(o.size));
+    const fs::path scratch = fs::temp_directory_path() / fmt::format("defocus-bench-write-{}", ::getpid());
+    const auto writeAll = [&](std::size_t threads) {
+        fs::remove_all(scratch);
+        SinkOptions options(scratch.string() + "/");
+        options.threads = threads;
+        const auto start = std::chrono::steady_clock::now();
+        BackgroundSink sink(openSink(options));
+        for (std::size_t i = 0; i < o.frames; ++i) {
+            Frame origin = clip[i % clip.size()];
+            origin.index = i;
+            origin.timestampS = 1.0 + static_cast<double>(i) / 30.0;
+            origin.name = fmt::format("{:.6f}.png", origin.timestampS);
+            sink.writeFrame(origin.color, origin);
+        }
+        sink.finish();
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        std::size_t files = 0;
+        for (const auto& entry : fs::recursive_directory_iterator(scratch))
+            files += entry.path().extension() == ".png" ? 1 : 0;
+        fs::remove_all(scratch);
+        if (sink.framesWritten() != o.frames || files != 2 * o.frames)
+            throw std::runtime_error(fmt::format("{} threads wrote {} frames and {} PNG files, not {} and {}", threads,
+                                                 sink.framesWritten(), files, o.frames, 2 * o.frames));
+        return ms / static_cast<double>(o.frames);
+    };
+    writeAll(o.threads.front()); // unmeasured: the encoder's first use
+    std::vector<std::vector<double>> ms(o.threads.size());
+    for (int pass = 0; pass < o.passes; ++pass)
+        for (std::size_t i = 0; i < o.threads.size(); ++i)
+            ms[i].push_back(writeAll(o.threads[i]));
+    std::printf("defocus-bench write: %s at %dx%d, %zu frames, %d passes, %u CPUs here, encoding threads by "
+                "default: %zu\n",
+                o.input.c_str(), clip.front().color.cols, clip.front().color.rows, o.frames, o.passes,
+                std::thread::hardware_concurrency(), ReadAheadSource::defaultThreads());
+    std::printf("%-8s %14s %10s\n", "threads", "ms per frame", "ratio");
+    double first = 0.0;
+    for (std::size_t i = 0; i < o.threads.size(); ++i) {
+        std::vector<double>& runs = ms[i];
+        std::nth_element(runs.begin(), runs.begin() + static_cast<std::ptrdiff_t>(runs.size() / 2), runs.end());
+        const double median = runs[runs.size() / 2];
+        if (i == 0)
+            first = median;
+        std::printf("%-8zu %14.2f %10.3f\n", o.threads[i], median, median / first);
+    }
+    return 0;
+}
+
 /// `defocus-bench accuracy ...` runs the accuracy sweep, built as its own program beside this one,
 /// with the arguments after the subcommand (its --help included).
 int runAccuracy(const std::vector<std::string>& rest, const char* self)
@@ -778,7 +869,7 @@ int main(int argc, char** argv)
     CLI::App app{"defocus-bench: milliseconds per pass and per frame of the defocus pipeline on the bundled TUM "
                  "clip, resized to each size; median and p90 of several runs, for a defocused and an all-in-focus "
                  "scene. Run it from the repository root. The subcommands time the per-frame plan (plan), hold the "
-                 "per-pass timing baseline (timing), time frames in flight against one at a time (throughput), time reading a clip ahead of the filter (read) and sweep accuracy against a path-traced lens (accuracy); "
+                 "per-pass timing baseline (timing), time frames in flight against one at a time (throughput), time reading a clip ahead of the filter (read) and writing a folder output behind it (write), and sweep accuracy against a path-traced lens (accuracy); "
                  "each has its own --help."};
     defocus::cli::addVersionFlag(app, "defocus-bench");
     app.require_subcommand(0, 1);
@@ -790,6 +881,8 @@ int main(int argc, char** argv)
     CLI::App* throughput = declareThroughput(app, throughputOptions);
     ReadOptions readOptions;
     CLI::App* read = declareRead(app, readOptions);
+    WriteOptions writeOptions;
+    CLI::App* write = declareWrite(app, writeOptions);
     CLI::App* accuracy = app.add_subcommand("accuracy", "Error against a path-traced thin lens and time per frame of "
                                                         "every method (defocus-bench-accuracy; 'accuracy --help' "
                                                         "lists its options)");
@@ -853,6 +946,8 @@ int main(int argc, char** argv)
             return defocus::runThroughput(throughputOptions);
         if (read->parsed())
             return runRead(readOptions);
+        if (write->parsed())
+            return runWrite(writeOptions);
         std::string commandLine = "defocus-bench";
         for (int i = 1; i < argc; ++i)
             commandLine += std::string(" ") + argv[i];
