@@ -687,6 +687,34 @@ CLI::App* declareThroughput(CLI::App& app, defocus::ThroughputOptions& o)
     return sub;
 }
 
+/// The read and write subcommands' table: a row per number of threads (`labels`), the median of
+/// its passes' ms per frame and its ratio to the first row's.
+void printMedians(const std::vector<std::string>& labels, std::vector<std::vector<double>>& ms)
+{
+    std::printf("%-8s %14s %10s\n", "threads", "ms per frame", "ratio");
+    double first = 0.0;
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        std::vector<double>& runs = ms[i];
+        std::nth_element(runs.begin(), runs.begin() + static_cast<std::ptrdiff_t>(runs.size() / 2), runs.end());
+        const double median = runs[runs.size() / 2];
+        if (i == 0)
+            first = median;
+        std::printf("%-8s %14.2f %10.3f\n", labels[i].c_str(), median, median / first);
+    }
+}
+
+/// The read and write subcommands' --threads (`what` threads, a list) and --passes.
+void addThreadsAndPasses(CLI::App& sub, std::vector<std::size_t>& threads, int& passes, const std::string& what)
+{
+    sub.add_option("--threads", threads, what + " threads, comma-separated")
+        ->delimiter(',')
+        ->check(cli::between(1, 64))
+        ->capture_default_str();
+    sub.add_option("--passes", passes, "Timed passes per number of threads, interleaved")
+        ->check(cli::between(1, 1000))
+        ->capture_default_str();
+}
+
 /// `defocus-bench read`: what reading a recorded clip ahead of the filter costs per frame, as the
 /// command line reads it (depth as stored, ReadAheadSource), on 1..N threads.
 struct ReadOptions {
@@ -707,13 +735,7 @@ CLI::App* declareRead(CLI::App& app, ReadOptions& o)
         ->capture_default_str();
     sub->add_option("--depth", o.depth, "Its --depth");
     sub->add_option("--depth-scale", o.depthScale, "Its --depth-scale");
-    sub->add_option("--threads", o.threads, "Reading threads, comma-separated")
-        ->delimiter(',')
-        ->check(cli::between(1, 64))
-        ->capture_default_str();
-    sub->add_option("--passes", o.passes, "Timed passes per number of threads, interleaved")
-        ->check(cli::between(1, 1000))
-        ->capture_default_str();
+    addThreadsAndPasses(*sub, o.threads, o.passes, "Reading");
     return sub;
 }
 
@@ -743,21 +765,15 @@ int runRead(const ReadOptions& o)
     std::printf("defocus-bench read: %s, %zu frames, %d passes, %u CPUs here, reading threads by default: %zu\n",
                 o.input.c_str(), frames, o.passes, std::thread::hardware_concurrency(),
                 ReadAheadSource::defaultThreads());
-    std::printf("%-8s %14s %10s\n", "threads", "ms per frame", "ratio");
-    double first = 0.0;
-    for (std::size_t i = 0; i < o.threads.size(); ++i) {
-        std::vector<double>& runs = ms[i];
-        std::nth_element(runs.begin(), runs.begin() + static_cast<std::ptrdiff_t>(runs.size() / 2), runs.end());
-        const double median = runs[runs.size() / 2];
-        if (i == 0)
-            first = median;
-        std::printf("%-8zu %14.2f %10.3f\n", o.threads[i], median, median / first);
-    }
+    std::vector<std::string> labels;
+    for (const std::size_t threads : o.threads)
+        labels.push_back(std::to_string(threads));
+    printMedians(labels, ms);
     return 0;
 }
 
-/// `defocus-bench write`: what writing a folder output (DIR/, PNG in the TUM layout) costs per
-/// frame, as the command line writes it (a BackgroundSink over the sequence), on 1..N threads.
+/// `defocus-bench write`: what writing an output costs per frame, as the command line writes it (a
+/// BackgroundSink over the sink): a folder (DIR/, PNG in the TUM layout) on 1..N threads, or a video.
 struct WriteOptions {
     std::string input = "data/tum_fr1_rpy";
     std::string size;
@@ -769,21 +785,16 @@ struct WriteOptions {
 
 CLI::App* declareWrite(CLI::App& app, WriteOptions& o)
 {
-    CLI::App* sub = app.add_subcommand("write", "Milliseconds per frame of writing a folder output (PNG colour and "
-                                                "16-bit depth, the TUM layout) as the command line does, from the "
-                                                "filter's call to the finished folder, on each number of encoding "
-                                                "threads, passes interleaved, into the system's temporary folder; "
-                                                "median of the passes and its ratio to the first number's");
+    CLI::App* sub = app.add_subcommand("write", "Milliseconds per frame of writing an output as the command line "
+                                                "does, from the filter's call to the finished output, into the "
+                                                "system's temporary folder: a folder (PNG colour and 16-bit depth, "
+                                                "the TUM layout) on each number of encoding threads, or a video "
+                                                "(--as); passes interleaved; median of the passes and its ratio to "
+                                                "the first number's");
     sub->add_option("INPUT", o.input, "A TUM folder whose frames (repeated as needed) are written")->capture_default_str();
     sub->add_option("--size", o.size, "Frame size WIDTHxHEIGHT [default: the clip's]");
     sub->add_option("--frames", o.frames, "Frames per pass")->check(cli::between(1, 100000))->capture_default_str();
-    sub->add_option("--threads", o.threads, "Encoding threads, comma-separated")
-        ->delimiter(',')
-        ->check(cli::between(1, 64))
-        ->capture_default_str();
-    sub->add_option("--passes", o.passes, "Timed passes per number of threads, interleaved")
-        ->check(cli::between(1, 1000))
-        ->capture_default_str();
+    addThreadsAndPasses(*sub, o.threads, o.passes, "Encoding");
     sub->add_option("--as", o.as,
                     "The output: a folder, or a video with the container's default codec (colour only; its "
                     "encoder's own threads, --threads not used)")
@@ -846,17 +857,10 @@ int runWrite(const WriteOptions& o)
                 o.input.c_str(), clip.front().color.cols, clip.front().color.rows, o.as.c_str(), o.frames, o.passes,
                 std::thread::hardware_concurrency(),
                 folder ? std::to_string(ReadAheadSource::defaultThreads()).c_str() : "the encoder's");
-    std::printf("%-8s %14s %10s\n", "threads", "ms per frame", "ratio");
-    double first = 0.0;
-    for (std::size_t i = 0; i < threadCounts.size(); ++i) {
-        std::vector<double>& runs = ms[i];
-        std::nth_element(runs.begin(), runs.begin() + static_cast<std::ptrdiff_t>(runs.size() / 2), runs.end());
-        const double median = runs[runs.size() / 2];
-        if (i == 0)
-            first = median;
-        std::printf("%-8s %14.2f %10.3f\n", folder ? std::to_string(threadCounts[i]).c_str() : "encoder's", median,
-                    median / first);
-    }
+    std::vector<std::string> labels;
+    for (const std::size_t threads : threadCounts)
+        labels.push_back(folder ? std::to_string(threads) : "encoder's");
+    printMedians(labels, ms);
     return 0;
 }
 

@@ -137,6 +137,36 @@ protected:
         return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readText(out), readText(err)};
     }
 
+    /// The 2-frame clip to a folder with `option` (a thread count) 1 and 3: the debug line that
+    /// begins `debugLine` names the threads, the two folders hold the same files byte for byte,
+    /// and 65 is refused with one line naming the option (exit 2).
+    static void expectThreadsLeaveTheFilesAsTheyWere(const std::string& option, const std::string& debugLine)
+    {
+        const std::string input =
+            fmt::format("'{}' --depth '{}' --focus 1 -y", file("clip/rgb").string(), file("clip/depth").string());
+        const std::string stem = option.substr(2);
+        const fs::path oneOut = file(stem + "_1"), threeOut = file(stem + "_3");
+        const Ran one = defocus(fmt::format("{} -v {} 1 -o '{}/'", input, option, oneOut.string()));
+        const Ran three = defocus(fmt::format("{} -v {} 3 -o '{}/'", input, option, threeOut.string()));
+        ASSERT_EQ(one.exitCode, 0) << one.err;
+        ASSERT_EQ(three.exitCode, 0) << three.err;
+        EXPECT_NE(one.err.find(debugLine + " 1 thread\n"), std::string::npos) << one.err;
+        EXPECT_NE(three.err.find(debugLine + " 3 threads\n"), std::string::npos) << three.err;
+        std::size_t files = 0;
+        for (const auto& entry : fs::recursive_directory_iterator(oneOut)) {
+            if (!entry.is_regular_file())
+                continue;
+            ++files;
+            const fs::path same = threeOut / fs::relative(entry.path(), oneOut);
+            ASSERT_TRUE(fs::exists(same)) << same;
+            EXPECT_EQ(readText(entry.path()), readText(same)) << same;
+        }
+        EXPECT_GE(files, 4u) << "two frames, their depth and the lists";
+        const Ran bad = defocus(fmt::format("{} {} 65 -o '{}/'", input, option, file(stem + "_bad").string()));
+        EXPECT_EQ(bad.exitCode, 2);
+        EXPECT_NE(bad.err.find(option + " must be between 0 and 64"), std::string::npos) << bad.err;
+    }
+
     /// The renderer `defocus --info` names is a software one (gl::isSoftwareRenderer()): the
     /// renderer's own choices (depth prep, the presets' precision) are the CPU's and 32f there.
     static bool softwareRenderer()
@@ -869,28 +899,7 @@ TEST_F(CliFlags, QuietVerboseAndVersion)
 // taken.
 TEST_F(CliFlags, ReadThreadsDecodeAheadAndTheFramesStayAsTheyWere)
 {
-    const std::string input =
-        fmt::format("'{}' --depth '{}' --focus 1 -y", file("clip/rgb").string(), file("clip/depth").string());
-    const fs::path oneOut = file("read_threads_1"), threeOut = file("read_threads_3");
-    const Ran one = defocus(input + " -v --read-threads 1 -o '" + oneOut.string() + "/'");
-    const Ran three = defocus(input + " -v --read-threads 3 -o '" + threeOut.string() + "/'");
-    ASSERT_EQ(one.exitCode, 0) << one.err;
-    ASSERT_EQ(three.exitCode, 0) << three.err;
-    EXPECT_NE(one.err.find("reading ahead on 1 thread\n"), std::string::npos) << one.err;
-    EXPECT_NE(three.err.find("reading ahead on 3 threads\n"), std::string::npos) << three.err;
-    std::size_t files = 0;
-    for (const auto& entry : fs::recursive_directory_iterator(oneOut)) {
-        if (!entry.is_regular_file())
-            continue;
-        ++files;
-        const fs::path same = threeOut / fs::relative(entry.path(), oneOut);
-        ASSERT_TRUE(fs::exists(same)) << same;
-        EXPECT_EQ(readText(entry.path()), readText(same)) << same;
-    }
-    EXPECT_GE(files, 4u) << "two frames, their depth and the lists";
-    const Ran bad = defocus(input + " --read-threads 65 -o '" + file("read_threads_bad").string() + "/'");
-    EXPECT_EQ(bad.exitCode, 2);
-    EXPECT_NE(bad.err.find("--read-threads must be between 0 and 64"), std::string::npos) << bad.err;
+    expectThreadsLeaveTheFilesAsTheyWere("--read-threads", "reading ahead on");
 }
 
 // Defects caught: --write-threads not reaching a folder output (the debug line names the threads
@@ -898,28 +907,7 @@ TEST_F(CliFlags, ReadThreadsDecodeAheadAndTheFramesStayAsTheyWere)
 // another order, a value out of range taken.
 TEST_F(CliFlags, WriteThreadsEncodeAFoldersFramesAndTheFilesStayAsTheyWere)
 {
-    const std::string input =
-        fmt::format("'{}' --depth '{}' --focus 1 -y", file("clip/rgb").string(), file("clip/depth").string());
-    const fs::path oneOut = file("write_threads_1"), threeOut = file("write_threads_3");
-    const Ran one = defocus(input + " -v --write-threads 1 -o '" + oneOut.string() + "/'");
-    const Ran three = defocus(input + " -v --write-threads 3 -o '" + threeOut.string() + "/'");
-    ASSERT_EQ(one.exitCode, 0) << one.err;
-    ASSERT_EQ(three.exitCode, 0) << three.err;
-    EXPECT_NE(one.err.find("encoding the frames on 1 thread\n"), std::string::npos) << one.err;
-    EXPECT_NE(three.err.find("encoding the frames on 3 threads\n"), std::string::npos) << three.err;
-    std::size_t files = 0;
-    for (const auto& entry : fs::recursive_directory_iterator(oneOut)) {
-        if (!entry.is_regular_file())
-            continue;
-        ++files;
-        const fs::path same = threeOut / fs::relative(entry.path(), oneOut);
-        ASSERT_TRUE(fs::exists(same)) << same;
-        EXPECT_EQ(readText(entry.path()), readText(same)) << same;
-    }
-    EXPECT_GE(files, 4u) << "two frames, their depth and the lists";
-    const Ran bad = defocus(input + " --write-threads 65 -o '" + file("write_threads_bad").string() + "/'");
-    EXPECT_EQ(bad.exitCode, 2);
-    EXPECT_NE(bad.err.find("--write-threads must be between 0 and 64"), std::string::npos) << bad.err;
+    expectThreadsLeaveTheFilesAsTheyWere("--write-threads", "encoding the frames on");
 }
 
 // Defect: an option added to the command line with no test through the binary. Every option
