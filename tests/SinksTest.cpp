@@ -634,8 +634,9 @@ FailedRun writeAroundAFailure(FrameSink& sink, const fs::path& work, bool sideBy
             run.writtenAtFirstError = sink.framesWritten();
     }
     reader.join(); // frame 2 was encoded before finish() returned
-    if (sideBySide)
+    if (sideBySide) {
         EXPECT_TRUE(fs::exists(work / "frame_000004.png")) << "frames 3 and 4 not written while frame 2 waited";
+    }
     return run;
 }
 
@@ -660,10 +661,11 @@ TEST(ImageSequenceSink, AFailedWriteCountsTheFramesBeforeItAndKeepsNoneAfter)
             }
             const FailedRun run = writeAroundAFailure(*sink, temporaryPath(dir, true), threads > 1);
             EXPECT_GE(run.thrown, 1);
-            if (!background)
+            if (!background) {
                 EXPECT_EQ(run.writtenAtFirstError, 2u);
-            else
+            } else {
                 EXPECT_EQ(behind->failedFrame(), std::optional<std::size_t>(2));
+            }
             EXPECT_EQ(sink->framesWritten(), 2u);
             EXPECT_FALSE(fs::exists(dir)) << "a failed run's output under its final name";
             const fs::path kept = sink->abandon(true);
