@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// sRGB decode/encode, with a 256-entry table for 8-bit decode.
+// sRGB decode/encode, with a 256-entry table for 8-bit decode; Y'CbCr 4:2:0 to BGR.
 #include "filter/ColorSpace.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+
+#include <fmt/format.h>
 
 namespace defocus {
 
@@ -63,6 +66,76 @@ cv::Mat encodeSrgb(const cv::Mat& linear)
         }
     }
     return out;
+}
+
+YuvCoefficients yuvCoefficients(YuvImage::Matrix matrix, YuvImage::Range range)
+{
+    const double kr = matrix == YuvImage::Matrix::Bt601 ? 0.299 : 0.2126;
+    const double kb = matrix == YuvImage::Matrix::Bt601 ? 0.114 : 0.0722;
+    const double kg = 1.0 - kr - kb;
+    const bool limited = range == YuvImage::Range::Limited;
+    const double chroma = limited ? 255.0 / 224.0 : 1.0; // Cb and Cr span 224 codes, or 255
+    const auto fixed = [](double x) { return static_cast<int>(std::lround(256.0 * x)); };
+    YuvCoefficients c;
+    c.yOffset = limited ? 16 : 0;
+    c.yScale = fixed(limited ? 255.0 / 219.0 : 1.0);
+    c.crToR = fixed(2.0 * (1.0 - kr) * chroma);
+    c.cbToG = fixed(2.0 * kb * (1.0 - kb) / kg * chroma);
+    c.crToG = fixed(2.0 * kr * (1.0 - kr) / kg * chroma);
+    c.cbToB = fixed(2.0 * (1.0 - kb) * chroma);
+    return c;
+}
+
+std::string yuvProblem(const YuvImage& image)
+{
+    if (image.y.empty())
+        return "Y'CbCr image: the luma plane (y) is empty";
+    if (image.y.type() != CV_8UC1)
+        return fmt::format("Y'CbCr image: the luma plane (y) is {}; expected 8-bit (CV_8UC1)",
+                           cv::typeToString(image.y.type()));
+    const cv::Size half((image.y.cols + 1) / 2, (image.y.rows + 1) / 2);
+    const bool nv12 = image.layout == YuvImage::Layout::Nv12;
+    const auto plane = [&](const cv::Mat& m, const char* name, int type) -> std::string {
+        if (m.type() == type && m.size() == half)
+            return {};
+        return fmt::format("Y'CbCr image: {} is {} {}x{}; expected {} {}x{} for a {}x{} {} image", name,
+                           m.empty() ? std::string("empty") : cv::typeToString(m.type()), m.cols, m.rows,
+                           cv::typeToString(type), half.width, half.height, image.y.cols, image.y.rows,
+                           nv12 ? "NV12" : "I420");
+    };
+    if (nv12) {
+        if (!image.v.empty())
+            return "Y'CbCr image: v is for I420's Cr plane; an NV12 image has Cb and Cr in u";
+        return plane(image.u, "the chroma plane (u)", CV_8UC2);
+    }
+    if (std::string problem = plane(image.u, "the Cb plane (u)", CV_8UC1); !problem.empty())
+        return problem;
+    return plane(image.v, "the Cr plane (v)", CV_8UC1);
+}
+
+cv::Mat convertYuv(const YuvImage& image)
+{
+    const YuvCoefficients c = yuvCoefficients(image.matrix, image.range);
+    const bool nv12 = image.layout == YuvImage::Layout::Nv12;
+    cv::Mat bgr(image.y.size(), CV_8UC3);
+    const auto clamp8 = [](int v) { return static_cast<std::uint8_t>(std::clamp(v >> 8, 0, 255)); };
+    cv::parallel_for_(cv::Range(0, bgr.rows), [&](const cv::Range& rows) {
+        for (int y = rows.start; y < rows.end; ++y) {
+            const std::uint8_t* luma = image.y.ptr<std::uint8_t>(y);
+            const std::uint8_t* cb = image.u.ptr<std::uint8_t>(y / 2);
+            const std::uint8_t* cr = nv12 ? cb + 1 : image.v.ptr<std::uint8_t>(y / 2);
+            const int step = nv12 ? 2 : 1;
+            auto* out = bgr.ptr<std::uint8_t>(y);
+            for (int x = 0; x < bgr.cols; ++x) {
+                const int l = c.yScale * (luma[x] - c.yOffset) + 128;
+                const int u = cb[(x / 2) * step] - 128, v = cr[(x / 2) * step] - 128;
+                out[3 * x + 0] = clamp8(l + c.cbToB * u);
+                out[3 * x + 1] = clamp8(l - c.cbToG * u - c.crToG * v);
+                out[3 * x + 2] = clamp8(l + c.crToR * v);
+            }
+        }
+    });
+    return bgr;
 }
 
 } // namespace defocus

@@ -16,6 +16,7 @@ using enum Image;
 using F = ImageFormat;
 constexpr std::array<ImageInfo, kImageCount> kImages{{
     {"input colour", ImageScale::Frame, F::Color},
+    {"input colour planes", ImageScale::Given, F::Planes},
     {"depth as given", ImageScale::Given, F::Given},
     {"filled depth", ImageScale::Frame, F::Metres},
     {"scene measurement", ImageScale::None, F::Measurement},
@@ -58,17 +59,21 @@ const ImageInfo& imageInfo(Image image)
     return kImages[static_cast<std::size_t>(image)];
 }
 
-std::vector<Image> frameImports(bool depthPrepOnGpu)
+std::vector<Image> frameImports(bool depthPrepOnGpu, bool yuvColor)
 {
-    return {Color, depthPrepOnGpu ? DepthAsGiven : Depth, NearDiameter};
+    return {depthPrepOnGpu && yuvColor ? ColorPlanes : Color, depthPrepOnGpu ? DepthAsGiven : Depth, NearDiameter};
 }
 
-std::vector<Node> prepareNodes(bool depthPrepOnGpu, bool lightEdges)
+std::vector<Node> prepareNodes(bool depthPrepOnGpu, bool lightEdges, bool yuvColor)
 {
     if (!depthPrepOnGpu)
         return {};
-    return {{PassKind::DepthPrep, "depth-prep", with({DepthAsGiven}, lightEdges, Color), {Depth}},
-            {PassKind::SceneMeasure, "scene-measure", {Depth, Color}, {Measurement}}};
+    std::vector<Node> nodes;
+    if (yuvColor)
+        nodes.push_back({PassKind::YuvToRgb, "yuv-to-rgb", {ColorPlanes}, {Color}});
+    nodes.push_back({PassKind::DepthPrep, "depth-prep", with({DepthAsGiven}, lightEdges, Color), {Depth}});
+    nodes.push_back({PassKind::SceneMeasure, "scene-measure", {Depth, Color}, {Measurement}});
+    return nodes;
 }
 
 std::vector<Node> frameNodes(const GraphChoices& c)

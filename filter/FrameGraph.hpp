@@ -25,6 +25,7 @@ namespace defocus {
 /// The images (and one buffer) the passes of a frame read and write.
 enum class Image : std::uint8_t {
     Color,          ///< the frame's colour, linear (imported: uploaded before the graph runs)
+    ColorPlanes,    ///< the frame's colour as Y'CbCr planes (imported where they go up as they came)
     DepthAsGiven,   ///< the frame's depth as it came (imported where depth prep runs on the GPU)
     Depth,          ///< the frame's filled depth, the frame's size (depth prep's, or imported)
     Measurement,    ///< the scene measurement, a buffer the CPU reads back to plan the frame
@@ -60,6 +61,7 @@ enum class ImageFormat : std::uint8_t {
     Work,   ///< the blur targets' RGBA (rgb linear, a the signed CoC): RGBA16F or RGBA32F, by the
             ///< frame's TargetFormat; the pipeline's pool holds these
     Color,  ///< the frame as it went up: sRGB8 (decoded to linear on fetch) or RGB32F
+    Planes, ///< Y'CbCr 4:2:0 as it came: R8UI and RG8UI (NV12) or R8UI (I420) planes
     Given,  ///< the depth as it came: R16UI in its units, or R32F metres
     Metres, ///< R32F metres
     Measurement, ///< SceneMeasurePass's storage buffer
@@ -80,6 +82,7 @@ const ImageInfo& imageInfo(Image image);
 
 /// What a node runs; Pipeline has one way to run each.
 enum class PassKind : std::uint8_t {
+    YuvToRgb,         ///< Y'CbCr planes to the frame's colour
     DepthPrep,        ///< the depth resized to the frame and its holes filled
     SceneMeasure,     ///< the valid depths' range, the tiles' CoC ranges, the highlights
     Coc,              ///< the CoC pass, the bokeh sprites found first when the plan has them
@@ -118,15 +121,17 @@ struct GraphChoices {
     bool sprites = false;    ///< FramePlan::highlightSprites
 };
 
-/// The images a frame has before any node runs (its uploads): the colour, the near field's
-/// diameters (uploaded when the frame is planned), and the depth as it came where depth prep
-/// runs on the GPU (`depthPrepOnGpu`), the filled depth where it ran on the CPU.
-std::vector<Image> frameImports(bool depthPrepOnGpu);
+/// The images a frame has before any node runs (its uploads): the colour (its Y'CbCr planes
+/// where it came so, `yuvColor`, and the GPU prepares it), the near field's diameters (uploaded
+/// when the frame is planned), and the depth as it came where depth prep runs on the GPU
+/// (`depthPrepOnGpu`), the filled depth where it ran on the CPU.
+std::vector<Image> frameImports(bool depthPrepOnGpu, bool yuvColor = false);
 
-/// The nodes that prepare a frame for its plan, before the frame's nodes: depth prep and the
-/// scene measurement on the GPU (`lightEdges`: depth prep reads the colour to put the lights'
-/// edges at their lights' depth); none where they run on the CPU.
-std::vector<Node> prepareNodes(bool depthPrepOnGpu, bool lightEdges);
+/// The nodes that prepare a frame for its plan, before the frame's nodes: on the GPU, the colour
+/// from its Y'CbCr planes where it came so (`yuvColor`), depth prep and the scene measurement
+/// (`lightEdges`: depth prep reads the colour to put the lights' edges at their lights' depth);
+/// none where they run on the CPU (which converts Y'CbCr itself).
+std::vector<Node> prepareNodes(bool depthPrepOnGpu, bool lightEdges, bool yuvColor = false);
 
 /// The nodes every frame that is not all in focus runs, whatever is read: the CoC and the blurs
 /// as far as they go without knowing the view.

@@ -40,6 +40,7 @@
 #include "filter/passes/OutputCopyPass.hpp"
 #include "filter/passes/UpscalePass.hpp"
 #include "filter/passes/ViewPass.hpp"
+#include "filter/passes/YuvToRgbPass.hpp"
 
 namespace defocus {
 
@@ -191,8 +192,10 @@ std::string_view rendererName()
 /// can go up and be measured before this one's passes run) and what the CPU found.
 struct FrameContext {
     /// The frame's images, kept until its passes have run (they are skipped when all is in
-    /// focus and the composite is all that is read).
+    /// focus and the composite is all that is read). `color` is empty where the colour came as
+    /// Y'CbCr planes (`yuv`) and has not been converted on the CPU.
     cv::Mat color, depthInput;
+    YuvImage yuv;
     /// depthInput's units a metre where it is 16-bit (CV_16UC1); 0: float metres.
     double depthUnits = 0.0;
     cv::Size size;
@@ -221,6 +224,8 @@ struct FrameContext {
 
     gl::Texture colorTexture;
     gl::Texture colorBytes;   ///< 8-bit frames: colorTexture's bytes, undecoded (SceneMeasurePass)
+    gl::Framebuffer colorBytesTarget; ///< colorBytes', for YuvToRgbPass
+    gl::Texture yuvPlanes[3]; ///< Y'CbCr frames' planes as they came: Y', Cb (NV12: Cb and Cr), Cr
     gl::Texture depthAsGiven; ///< the frame's depth as it came (prepareOnGpu)
     gl::Texture depth;        ///< filled, the frame's size
     gl::Framebuffer depthTarget; ///< `depth`'s (DepthPrepPass writes it)
@@ -268,6 +273,7 @@ struct Pipeline::Impl {
     RhombusBlurPass rhombusBlurPass;
     CompositePass compositePass;
     CopyPass copyPass;
+    YuvToRgbPass yuvToRgbPass;
     NearBlurPass nearBlurPass;
     UpscalePass upscalePass;
     ViewPass viewPass;
@@ -355,24 +361,45 @@ struct Pipeline::Impl {
         if (ensureTexture(f.depth, GL_R32F, f.size, "filled depth"))
             f.depthTarget = gl::Framebuffer(f.depth, "filled depth");
     }
-    /// `f`'s colour into its colorTexture (and its bytes' view), through `ring` or straight.
-    static void uploadColor(FrameContext& f, gl::UploadRing* ring)
+    /// `f`'s colour into its colorTexture (and its bytes' view), through `ring` or straight: BGR
+    /// or float as it is; Y'CbCr planes as they are, into yuvPlanes (the yuv-to-rgb node converts
+    /// them).
+    void uploadColor(FrameContext& f, gl::UploadRing* ring)
     {
-        const bool srgbInput = f.color.depth() == CV_8U;
-        if (ensureTexture(f.colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, f.size, "input colour"))
+        const bool srgbInput = f.color.depth() == CV_8U; // an empty Mat's too: Y'CbCr
+        if (ensureTexture(f.colorTexture, srgbInput ? GL_SRGB8 : GL_RGB32F, f.size, "input colour")) {
             f.colorBytes =
                 srgbInput ? gl::Texture::view(f.colorTexture, GL_RGB8, "input colour, bytes") : gl::Texture();
-        // BGRx goes up as it is: the texture has no alpha, so the fourth byte is dropped on the way.
-        const GLenum format = f.color.channels() == 4 ? GL_BGRA : GL_BGR;
-        const GLenum type = srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT;
-        if (ring)
-            ring->upload(f.colorTexture, format, type, f.color.data, f.color.total() * f.color.elemSize());
-        else
-            f.colorTexture.upload(format, type, f.color.data);
+            f.colorBytesTarget = gl::Framebuffer();
+        }
+        const auto up = [&](gl::Texture& texture, GLenum format, GLenum type, const cv::Mat& image) {
+            if (ring)
+                ring->upload(texture, format, type, image.data, image.total() * image.elemSize());
+            else
+                texture.upload(format, type, image.data);
+        };
+        if (!f.color.empty()) {
+            // BGRx goes up as it is: the texture has no alpha, so the fourth byte is dropped on the way.
+            up(f.colorTexture, f.color.channels() == 4 ? GL_BGRA : GL_BGR, srgbInput ? GL_UNSIGNED_BYTE : GL_FLOAT,
+               f.color);
+            return;
+        }
+        const bool nv12 = f.yuv.layout == YuvImage::Layout::Nv12;
+        const cv::Mat* planes[3] = {&f.yuv.y, &f.yuv.u, nv12 ? nullptr : &f.yuv.v};
+        static const char* const kNames[3] = {"Y' plane", "Cb plane", "Cr plane"};
+        for (int i = 0; i < 3; ++i) {
+            if (!planes[i])
+                continue;
+            const bool pair = planes[i]->channels() == 2;
+            ensureTexture(f.yuvPlanes[i], pair ? GL_RG8UI : GL_R8UI, planes[i]->size(), kNames[i]);
+            up(f.yuvPlanes[i], pair ? GL_RG_INTEGER : GL_RED_INTEGER, GL_UNSIGNED_BYTE, *planes[i]);
+        }
+        if (!f.colorBytesTarget)
+            f.colorBytesTarget = gl::Framebuffer(f.colorBytes, "input colour, bytes");
     }
     /// begin()'s work on `f`: the frame, its settings, the all-in-focus exit or depth prep.
     void begin(FrameContext& f, const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
-               double depthUnitsPerMetre);
+               double depthUnitsPerMetre, const YuvImage* yuv);
     /// Depth prep and the scene measurement of `f`: on the GPU, the frame's images uploaded and
     /// the measurement submitted (read by plan()); on the CPU, both done and the filled depth uploaded.
     void prepare(FrameContext& f);
@@ -420,25 +447,26 @@ Pipeline::Pipeline(bool timers)
 Pipeline::~Pipeline() = default;
 
 void Pipeline::process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
-                       double depthUnitsPerMetre)
+                       double depthUnitsPerMetre, const YuvImage* yuv)
 {
     CV_Assert(impl_->staged.empty());
-    begin(frame, lens, quality, depthUnitsPerMetre);
+    begin(frame, lens, quality, depthUnitsPerMetre, yuv);
     finish();
 }
 
 void Pipeline::begin(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
-                     double depthUnitsPerMetre)
+                     double depthUnitsPerMetre, const YuvImage* yuv)
 {
     Impl& p = *impl_;
-    CV_Assert(!frame.color.empty() &&
-              (frame.color.type() == CV_8UC3 || frame.color.type() == CV_8UC4 || frame.color.type() == CV_32FC3));
+    CV_Assert(yuv ? frame.color.empty() && yuvProblem(*yuv).empty()
+                  : !frame.color.empty() && (frame.color.type() == CV_8UC3 || frame.color.type() == CV_8UC4 ||
+                                             frame.color.type() == CV_32FC3));
     FrameContext f;
     if (!p.spareContexts.empty()) {
         f = std::move(p.spareContexts.back());
         p.spareContexts.pop_back();
     }
-    p.begin(f, frame, lens, quality, depthUnitsPerMetre);
+    p.begin(f, frame, lens, quality, depthUnitsPerMetre, yuv);
     f.beginMs = msSince(f.frameStart);
     p.staged.push_back(std::move(f));
 }
@@ -459,12 +487,20 @@ void Pipeline::dropBegun()
 }
 
 void Pipeline::Impl::begin(FrameContext& f, const Frame& frame, const LensSettings& lens,
-                           const QualitySettings& quality, double depthUnitsPerMetre)
+                           const QualitySettings& quality, double depthUnitsPerMetre, const YuvImage* yuv)
 {
     f.timings = {};
     f.frameStart = Clock::now();
-    f.size = frame.color.size();
+    f.size = yuv ? yuv->y.size() : frame.color.size();
     f.color = frame.color;
+    f.yuv = {};
+    if (yuv) {
+        // Planes go up whole rows at a time: a view with padded rows is copied.
+        f.yuv = *yuv;
+        for (cv::Mat* plane : {&f.yuv.y, &f.yuv.u, &f.yuv.v})
+            if (!plane->empty() && !plane->isContinuous())
+                *plane = plane->clone();
+    }
     f.depthInput = frame.depth;
     f.depthUnits = depthUnitsPerMetre;
     CV_Assert(f.depthInput.empty() || f.depthInput.type() == (f.depthUnits > 0.0 ? CV_16UC1 : CV_32FC1));
@@ -543,10 +579,18 @@ void Pipeline::Impl::prepare(FrameContext& f)
     // it (float frames only: 8-bit ones have nothing above white).
     const bool lightEdges =
         f.color.type() == CV_32FC3 && f.quality.kernel == HexagonKernel::RhombiSum && f.quality.highlightSprites;
-    const bool srgbInput = f.color.depth() == CV_8U;
-    CV_Assert(f.color.isContinuous());
-    const bool units = f.depthUnits > 0.0; // 16-bit depth
+    // Y'CbCr where the CPU prepares depth: BGR here, for the measurement and the upload (the
+    // colour's way to the GPU: upload time).
+    double convertMs = 0.0;
+    if (!prepareOnGpu && f.color.empty()) {
+        const auto converting = Clock::now();
+        f.color = convertYuv(f.yuv);
+        convertMs = msSince(converting);
+    }
     auto start = Clock::now();
+    const bool srgbInput = f.color.depth() == CV_8U; // Y'CbCr too
+    CV_Assert(f.color.empty() || f.color.isContinuous());
+    const bool units = f.depthUnits > 0.0; // 16-bit depth
     if (prepareOnGpu) {
         // The frame's pixels go up as they came; only the measurement comes back, read when the
         // frame is planned (planFrame()), by when the GPU has long made it when a frame is in
@@ -563,9 +607,14 @@ void Pipeline::Impl::prepare(FrameContext& f)
         f.timings.uploadMs = msSince(start);
         start = Clock::now();
         glBindVertexArray(vao.id());
-        for (const Node& node : prepareNodes(true, lightEdges)) {
+        for (const Node& node : prepareNodes(true, lightEdges, f.color.empty())) {
             timer.begin(node.name, f.serial);
             switch (node.pass) {
+            case PassKind::YuvToRgb:
+                yuvToRgbPass.run(f.yuvPlanes[0], f.yuvPlanes[1],
+                                 f.yuv.layout == YuvImage::Layout::Nv12 ? nullptr : &f.yuvPlanes[2], f.yuv.matrix,
+                                 f.yuv.range, f.colorBytesTarget);
+                break;
             case PassKind::DepthPrep:
                 depthPrepPass.run(f.hasDepth ? &f.depthAsGiven : nullptr, f.depthUnits, f.fallbackDepth,
                                   lightEdges ? &f.colorTexture : nullptr, f.depth, f.depthTarget);
@@ -598,7 +647,7 @@ void Pipeline::Impl::prepare(FrameContext& f)
         uploadColor(f, nullptr);
         CV_Assert(f.prepared.metres.isContinuous());
         f.depth.upload(GL_RED, GL_FLOAT, f.prepared.metres.data);
-        f.timings.uploadMs = msSince(start);
+        f.timings.uploadMs = convertMs + msSince(start);
         start = Clock::now();
         f.measurement = measureScene(f.prepared.metres, f.color, f.coefficients);
         f.timings.analysisMs += msSince(start);
@@ -792,6 +841,7 @@ void Pipeline::Impl::run(const Node& node, const Target* out, const gl::Framebuf
     case PassKind::OutputCopy:
         outputCopyPass.run(out->texture, out->generation, *caller, bgra);
         break;
+    case PassKind::YuvToRgb:
     case PassKind::DepthPrep:
     case PassKind::SceneMeasure:
         CV_Error(cv::Error::StsInternal, std::string(node.name) + " runs when a frame is begun (prepare())");
@@ -970,10 +1020,12 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
     if (view == View::Composite && !p.current.rendered) {
         // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
         // CoC pass's clean-up (no NaN, no negatives, within the target's range).
-        const bool srgbInput = p.current.color.depth() == CV_8U;
+        // Y'CbCr: the bytes the GPU would have made of it.
+        const cv::Mat color = p.current.color.empty() ? convertYuv(p.current.yuv) : p.current.color;
+        const bool srgbInput = color.depth() == CV_8U;
         const bool half = p.current.quality.targetFormat == TargetFormat::Rgba16F;
-        const cv::Mat linear = srgbInput ? cv::Mat() : sanitizeLinear(p.current.color, CocParams::largestColor(half));
-        read.ready = passThrough(p.current.color, linear, encoding);
+        const cv::Mat linear = srgbInput ? cv::Mat() : sanitizeLinear(color, CocParams::largestColor(half));
+        read.ready = passThrough(color, linear, encoding);
         p.current.timings.readbackMs = msSince(start);
         p.current.timings.totalMs = p.current.spentMs();
         read.timings = p.current.timings;

@@ -92,8 +92,11 @@ public:
     /// `depthUnitsPerMetre` 0: the frame's depth is CV_32FC1 metres; otherwise CV_16UC1 in those
     /// units (0: no measurement), uploaded as it is and converted on the GPU (converted on the
     /// CPU where depth prep runs there).
+    /// `yuv`: the frame's colour as Y'CbCr 4:2:0 planes (yuvProblem() found nothing wrong), with
+    /// `frame.color` empty; uploaded as they came and converted on the GPU (YuvToRgbPass), or
+    /// converted on the CPU (convertYuv()) where depth prep runs there.
     void process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
-                 double depthUnitsPerMetre = 0.0);
+                 double depthUnitsPerMetre = 0.0, const YuvImage* yuv = nullptr);
     /// process() in two halves, so that a frame's upload and measurement go ahead of the passes
     /// of the frame before it: begin() takes `frame`, uploads it and submits its depth prep and
     /// scene measurement (on the GPU; on the CPU it does them); finish() takes the oldest frame
@@ -106,7 +109,7 @@ public:
     /// passes, not with those of the frame read before it. The images are referenced until the
     /// frame's passes have run.
     void begin(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,
-               double depthUnitsPerMetre = 0.0);
+               double depthUnitsPerMetre = 0.0, const YuvImage* yuv = nullptr);
     void finish();
     /// Frames begun and not finished.
     std::size_t begun() const;

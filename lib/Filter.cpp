@@ -15,6 +15,7 @@
 
 #include "filter/ApiSettings.hpp"
 #include "filter/Autofocus.hpp"
+#include "filter/ColorSpace.hpp"
 #include "filter/DepthPrep.hpp"
 #include "filter/Pipeline.hpp"
 #include "filter/Presets.hpp"
@@ -212,6 +213,7 @@ struct Filter::Impl {
     FrameReport report;
     /// The last process()'s frame and lens, for contactSheet() to process it again.
     std::optional<Frame> lastFrame;
+    std::optional<YuvImage> lastYuv; ///< its colour where it came as Y'CbCr
     double lastDepthUnits = 0.0; ///< its 16-bit depth's units a metre; 0: float metres
     LensSettings lastLens;
     /// submit()'s frames on their way back, oldest first, each with its report.
@@ -233,16 +235,17 @@ struct Filter::Impl {
     /// The frame process(), submit() and processTextures() filter from the caller's images, and its lens (the
     /// autofocus stepped); throws InputError and SettingsError as process() documents. 16-bit
     /// depth stays as it came, its units a metre in `depthUnits` (0: the depth is float metres).
+    /// `yuv`: the colour as Y'CbCr planes, `color` not used (the frame's colour left empty).
     Frame admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens,
-                double& depthUnits);
+                double& depthUnits, const YuvImage* yuv = nullptr);
     /// admit() and the frame begun on the pipeline (whose context must be current): uploaded and
     /// measured; the frame and its lens kept for the report.
-    void beginFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
+    void beginFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS, const YuvImage* yuv = nullptr);
     /// beginFrame() and the frame finished: planned and its passes run (no frame in flight).
     void processFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
     /// submit() without its check: the frame begun, the one submitted before finished and its
     /// read queued, the frame queued into inFlight.
-    void submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS);
+    void submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS, const YuvImage* yuv = nullptr);
     /// receive() of a frame in flight (there must be one).
     cv::Mat receiveFrame();
     /// The pipeline's oldest begun frame (`entry`'s) planned and its passes run, its read queued.
@@ -370,13 +373,16 @@ const Settings& Filter::settings() const
 }
 
 Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double timestampS, LensSettings& frameLens,
-                          double& depthUnits)
+                          double& depthUnits, const YuvImage* yuv)
 {
     Impl& p = *this;
-    if (color.empty())
-        throw InputError("colour image is empty");
     Frame frame;
-    switch (color.type()) {
+    if (yuv) {
+        if (const std::string problem = yuvProblem(*yuv); !problem.empty())
+            throw InputError(problem);
+    } else if (color.empty()) {
+        throw InputError("colour image is empty");
+    } else switch (color.type()) {
     case CV_8UC3:
     case CV_8UC4: // BGRx: uploaded as it is, the fourth byte dropped on the way
     case CV_32FC3:
@@ -403,7 +409,7 @@ Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double tim
                                          "metre) or float metres (CV_32FC1)",
                                          describeType(depth), p.settings.depthScale));
         }
-        if (const std::string problem = depthFitProblem(color.size(), "colour", depth.size(), "depth");
+        if (const std::string problem = depthFitProblem(yuv ? yuv->y.size() : color.size(), "colour", depth.size(), "depth");
             !problem.empty())
             throw InputError(problem);
     }
@@ -450,6 +456,23 @@ cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double times
                                 p.inFlight.size()));
     p.submitFrame(color, depth, timestampS);
     return p.receiveFrame();
+}
+
+cv::Mat Filter::process(const YuvImage& color, const cv::Mat& depth, double timestampS)
+{
+    Impl& p = *impl_;
+    if (!p.inFlight.empty())
+        throw Error(fmt::format("defocus::Filter::process(): {} frames in flight; receive() them first",
+                                p.inFlight.size()));
+    p.submitFrame({}, depth, timestampS, &color);
+    return p.receiveFrame();
+}
+
+cv::Mat yuvToBgr(const YuvImage& image)
+{
+    if (const std::string problem = yuvProblem(image); !problem.empty())
+        throw InputError(problem);
+    return convertYuv(image);
 }
 
 void Filter::Impl::fillReport(std::size_t index, const FrameTimings& t, FrameReport& r) const
@@ -500,13 +523,14 @@ std::vector<Timings::Pass> Filter::finishGpuTimings()
     return out;
 }
 
-void Filter::Impl::beginFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+void Filter::Impl::beginFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS, const YuvImage* yuv)
 {
     LensSettings frameLens;
     double depthUnits = 0.0;
-    Frame frame = admit(color, depth, timestampS, frameLens, depthUnits);
-    pipeline->begin(frame, frameLens, quality, depthUnits);
+    Frame frame = admit(color, depth, timestampS, frameLens, depthUnits, yuv);
+    pipeline->begin(frame, frameLens, quality, depthUnits, yuv);
     lastFrame = std::move(frame);
+    lastYuv = yuv ? std::optional<YuvImage>(*yuv) : std::nullopt;
     lastDepthUnits = depthUnits;
     lastLens = frameLens;
 }
@@ -517,10 +541,10 @@ void Filter::Impl::processFrame(const cv::Mat& color, const cv::Mat& depth, doub
     pipeline->finish();
 }
 
-void Filter::Impl::submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS)
+void Filter::Impl::submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS, const YuvImage* yuv)
 {
     const auto bound = current();
-    beginFrame(color, depth, timestampS);
+    beginFrame(color, depth, timestampS, yuv);
     // The frame submitted before goes on now, behind this one's upload and measurement: the GPU
     // runs its passes while the CPU plans it, and measures this one meanwhile.
     for (InFlight& entry : inFlight)
@@ -562,6 +586,13 @@ void Filter::submit(const cv::Mat& color, const cv::Mat& depth, double timestamp
     impl_->submitFrame(color, depth, timestampS);
 }
 
+void Filter::submit(const YuvImage& color, const cv::Mat& depth, double timestampS)
+{
+    if (!impl_->context)
+        throw Error("defocus::Filter::submit(): frames in GL textures go through processTextures()");
+    impl_->submitFrame({}, depth, timestampS, &color);
+}
+
 std::optional<cv::Mat> Filter::receive()
 {
     if (impl_->inFlight.empty())
@@ -592,7 +623,7 @@ cv::Mat Filter::contactSheet()
     cv::Mat sheet = defocus::contactSheet(tiles);
     // Processed again so that the timings are a plain frame's, not the views' reads.
     const Encoding encoding = toEncoding(p.settings.output);
-    pipeline.process(*p.lastFrame, p.lastLens, p.quality, p.lastDepthUnits);
+    pipeline.process(*p.lastFrame, p.lastLens, p.quality, p.lastDepthUnits, p.lastYuv ? &*p.lastYuv : nullptr);
     pipeline.read(toView(p.settings.view), encoding);
     p.fillReport(p.frames - 1);
     return sheet;

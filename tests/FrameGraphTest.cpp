@@ -54,14 +54,16 @@ TEST(FrameGraph, EveryListIsAValidFrame)
                           View::DiagonalB, View::Depth, View::Coc};
     for (const bool onGpu : {true, false})
         for (const bool lightEdges : {true, false})
+            for (const bool yuv : {false, true})
             for (const GraphChoices& c : everyChoice()) {
-                const std::vector<Node> frame = concat(prepareNodes(onGpu, lightEdges), frameNodes(c));
+                const std::vector<Node> frame = concat(prepareNodes(onGpu, lightEdges, yuv), frameNodes(c));
                 for (const View view : views)
                     for (bool toCaller : {false, true}) {
                         const std::vector<Node> nodes = concat(frame, viewNodes(c, view, writtenBy(frame), toCaller));
                         // Views other than the composite show one image of the frame's and leave the rest.
-                        EXPECT_EQ(graphError(nodes, view == View::Composite, frameImports(onGpu)), "")
-                            << label(c) << (onGpu ? ", GPU" : ", CPU") << " depth prep, view " << static_cast<int>(view)
+                        EXPECT_EQ(graphError(nodes, view == View::Composite, frameImports(onGpu, yuv)), "")
+                            << label(c) << (onGpu ? ", GPU" : ", CPU") << " depth prep" << (yuv ? ", Y'CbCr" : "")
+                            << ", view " << static_cast<int>(view)
                             << ": " << describe(nodes);
                         EXPECT_EQ(nodes.back().writes.back(), toCaller ? Image::CallerTexture : Image::Output)
                             << label(c);
@@ -120,6 +122,9 @@ TEST(FrameGraph, DepthPrepIsANodeWhereItRunsOnTheGpu)
 {
     EXPECT_EQ(describe(prepareNodes(true, true)), "depth-prep > scene-measure");
     EXPECT_EQ(describe(prepareNodes(false, true)), "");
+    // Y'CbCr colour: converted first on the GPU; on the CPU, before the upload.
+    EXPECT_EQ(describe(prepareNodes(true, true, true)), "yuv-to-rgb > depth-prep > scene-measure");
+    EXPECT_EQ(describe(prepareNodes(false, true, true)), "");
     const std::vector<Node> withEdges = prepareNodes(true, true), without = prepareNodes(true, false);
     EXPECT_EQ(withEdges.front().reads, (std::vector<Image>{Image::DepthAsGiven, Image::Color}));
     EXPECT_EQ(without.front().reads, std::vector<Image>{Image::DepthAsGiven});

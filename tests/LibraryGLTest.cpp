@@ -576,3 +576,191 @@ TEST_F(Library, BgrxInAndBgraOutAreTheBgrFramesResult)
         filter_->setSettings(settings_);
     }
 }
+
+namespace {
+
+/// `bgr` as Y'CbCr 4:2:0 planes by OpenCV (BT.601, limited range): I420, or NV12.
+defocus::YuvImage opencvYuv(const cv::Mat& bgr, defocus::YuvImage::Layout layout)
+{
+    const bool nv12 = layout == defocus::YuvImage::Layout::Nv12;
+    cv::Mat i420;
+    cv::cvtColor(bgr, i420, cv::COLOR_BGR2YUV_I420); // Y rows, then Cb, then Cr, each packed
+    const int w = bgr.cols, h = bgr.rows;
+    defocus::YuvImage yuv;
+    yuv.layout = layout;
+    yuv.matrix = defocus::YuvImage::Matrix::Bt601;
+    yuv.range = defocus::YuvImage::Range::Limited;
+    yuv.y = i420.rowRange(0, h).clone();
+    const cv::Mat cb = cv::Mat(h / 2, w / 2, CV_8UC1, i420.ptr(h)).clone();
+    const cv::Mat cr = cv::Mat(h / 2, w / 2, CV_8UC1, i420.ptr(h) + (w / 2) * (h / 2)).clone();
+    if (nv12) {
+        cv::merge(std::vector<cv::Mat>{cb, cr}, yuv.u);
+    } else {
+        yuv.u = cb;
+        yuv.v = cr;
+    }
+    return yuv;
+}
+
+/// The planes of `yuv` as views into larger images (rows padded, as a GstVideoFrame's may be).
+defocus::YuvImage padded(const defocus::YuvImage& yuv)
+{
+    defocus::YuvImage views = yuv;
+    for (cv::Mat* plane : {&views.y, &views.u, &views.v}) {
+        if (plane->empty())
+            continue;
+        cv::Mat wider(plane->rows, plane->cols + 24, plane->type(), cv::Scalar::all(77));
+        plane->copyTo(wider.colRange(0, plane->cols));
+        *plane = wider.colRange(0, plane->cols);
+    }
+    return views;
+}
+
+} // namespace
+
+// Defects caught: Cb and Cr swapped, a pixel given another block's chroma, the matrix or the range
+// of another standard (BT.601 for BT.709, limited for full), a clamp missing (wrapping at 0 or
+// 255). OpenCV's conversions are the references: its BT.601 limited range for 4:2:0, its JPEG one
+// (BT.601 full range) on the chroma repeated per 2x2 block; BT.709 by its primaries.
+TEST(LibraryYuv, ConversionIsOpenCvsAndTheStandardsColours)
+{
+    const Pair pair = bundled(9);
+    const cv::Mat bgr = cv::imread(pair.color.string(), cv::IMREAD_COLOR);
+    for (const auto layout : {defocus::YuvImage::Layout::I420, defocus::YuvImage::Layout::Nv12}) {
+        const bool nv12 = layout == defocus::YuvImage::Layout::Nv12;
+        const defocus::YuvImage yuv = opencvYuv(bgr, layout);
+        // OpenCV's own way back, from its packed layout.
+        cv::Mat packed(bgr.rows * 3 / 2, bgr.cols, CV_8UC1), reference;
+        yuv.y.copyTo(packed.rowRange(0, bgr.rows));
+        if (nv12) {
+            cv::Mat(bgr.rows / 2, bgr.cols, CV_8UC1, yuv.u.data).copyTo(packed.rowRange(bgr.rows, packed.rows));
+            cv::cvtColor(packed, reference, cv::COLOR_YUV2BGR_NV12);
+        } else {
+            cv::cvtColor(bgr, packed, cv::COLOR_BGR2YUV_I420);
+            cv::cvtColor(packed, reference, cv::COLOR_YUV2BGR_I420);
+        }
+        const cv::Mat ours = defocus::yuvToBgr(yuv);
+        ASSERT_EQ(ours.type(), CV_8UC3);
+        EXPECT_LE(cv::norm(ours, reference, cv::NORM_INF), 1.0) << (nv12 ? "NV12" : "I420");
+        EXPECT_TRUE(identical(defocus::yuvToBgr(padded(yuv)), ours)) << "planes with padded rows";
+    }
+    // Full range (JPEG): OpenCV's YCrCb on 4:4:4 planes, each block's chroma repeated.
+    defocus::YuvImage full = opencvYuv(bgr, defocus::YuvImage::Layout::I420);
+    full.range = defocus::YuvImage::Range::Full;
+    cv::Mat cb, cr, ycrcb, reference;
+    cv::resize(full.u, cb, full.y.size(), 0, 0, cv::INTER_NEAREST);
+    cv::resize(full.v, cr, full.y.size(), 0, 0, cv::INTER_NEAREST);
+    cv::merge(std::vector<cv::Mat>{full.y, cr, cb}, ycrcb);
+    cv::cvtColor(ycrcb, reference, cv::COLOR_YCrCb2BGR);
+    EXPECT_LE(cv::norm(defocus::yuvToBgr(full), reference, cv::NORM_INF), 1.0) << "BT.601 full range";
+    // BT.709: black, white and the primaries, limited and full, from their Y'CbCr by the standard.
+    const double kr = 0.2126, kb = 0.0722, kg = 1.0 - kr - kb;
+    for (const auto range : {defocus::YuvImage::Range::Limited, defocus::YuvImage::Range::Full}) {
+        const bool limited = range == defocus::YuvImage::Range::Limited;
+        for (const cv::Vec3d& rgb : {cv::Vec3d(0, 0, 0), cv::Vec3d(1, 1, 1), cv::Vec3d(1, 0, 0), cv::Vec3d(0, 1, 0),
+                                    cv::Vec3d(0, 0, 1)}) {
+            const double luma = kr * rgb[0] + kg * rgb[1] + kb * rgb[2];
+            const double pb = (rgb[2] - luma) / (2 * (1 - kb)), pr = (rgb[0] - luma) / (2 * (1 - kr));
+            const auto code = [](double v) { return cv::saturate_cast<uchar>(std::lround(v)); };
+            defocus::YuvImage one;
+            one.matrix = defocus::YuvImage::Matrix::Bt709;
+            one.range = range;
+            one.y = cv::Mat(2, 2, CV_8UC1, cv::Scalar(code(limited ? 16 + 219 * luma : 255 * luma)));
+            one.u = cv::Mat(1, 1, CV_8UC1, cv::Scalar(code(limited ? 128 + 224 * pb : 128 + 255 * pb)));
+            one.v = cv::Mat(1, 1, CV_8UC1, cv::Scalar(code(limited ? 128 + 224 * pr : 128 + 255 * pr)));
+            const cv::Vec3b out = defocus::yuvToBgr(one).at<cv::Vec3b>(1, 1);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(out[2 - c], 255 * rgb[c], 2.0)
+                    << (limited ? "limited" : "full") << " R'G'B' " << rgb << " channel " << c;
+        }
+    }
+}
+
+// Defects caught: planes of the wrong type or size taken (read past a plane's end), an NV12
+// image's stray Cr plane or an I420's missing one passing; each refused in one line naming it.
+TEST(LibraryYuv, PlanesOfTheWrongShapeAreInputErrorsNamingThem)
+{
+    const cv::Mat bgr(48, 64, CV_8UC3, cv::Scalar(40, 80, 120));
+    const defocus::YuvImage good = opencvYuv(bgr, defocus::YuvImage::Layout::I420);
+    const auto message = [](const defocus::YuvImage& yuv) {
+        try {
+            defocus::yuvToBgr(yuv);
+        } catch (const defocus::InputError& error) {
+            return std::string(error.what());
+        }
+        return std::string("accepted");
+    };
+    defocus::YuvImage wrong = good;
+    wrong.y = cv::Mat(48, 64, CV_16UC1);
+    EXPECT_NE(message(wrong).find("luma plane (y)"), std::string::npos) << message(wrong);
+    wrong = good;
+    wrong.u = good.u.rowRange(0, 20);
+    EXPECT_NE(message(wrong).find("Cb plane (u) is CV_8UC1 32x20; expected CV_8UC1 32x24"), std::string::npos)
+        << message(wrong);
+    wrong = good;
+    wrong.v = cv::Mat();
+    EXPECT_NE(message(wrong).find("Cr plane (v) is empty"), std::string::npos) << message(wrong);
+    wrong = opencvYuv(bgr, defocus::YuvImage::Layout::Nv12);
+    wrong.v = good.v;
+    EXPECT_NE(message(wrong).find("an NV12 image has Cb and Cr in u"), std::string::npos) << message(wrong);
+    wrong.v = cv::Mat();
+    wrong.layout = defocus::YuvImage::Layout::I420;
+    EXPECT_NE(message(wrong).find("Cb plane (u) is CV_8UC2"), std::string::npos) << message(wrong);
+}
+
+// Defects caught: Y'CbCr in that is not its BGR's result, on either path (the GPU's planes and
+// conversion pass under DEFOCUS_DEPTH_PREP=gpu, library_gpu_defaults; the CPU's conversion here):
+// a conversion that differs from yuvToBgr() by a level, planes with padded rows read as packed, a
+// frame all in focus that passes another colour through, frames in flight or the contact sheet
+// losing the planes. Every preset, both kernels, the plan on and off.
+TEST(LibraryYuv, YuvInIsTheResultOfItsBgrOnEveryPreset)
+{
+    const Pair pair = bundled(9);
+    cv::Mat bgr = cv::imread(pair.color.string(), cv::IMREAD_COLOR), depth;
+    cv::resize(bgr, bgr, {320, 240}, 0, 0, cv::INTER_AREA);
+    cv::resize(cv::imread(pair.depth.string(), cv::IMREAD_UNCHANGED), depth, {320, 240}, 0, 0, cv::INTER_NEAREST);
+    const cv::Mat flat(depth.size(), CV_16UC1, cv::Scalar(5000)); // all at the focus, 1 m
+    for (const auto layout : {defocus::YuvImage::Layout::I420, defocus::YuvImage::Layout::Nv12}) {
+        defocus::YuvImage yuv = padded(opencvYuv(bgr, layout));
+        yuv.matrix = defocus::YuvImage::Matrix::Bt709; // any: the same conversion either way
+        const cv::Mat converted = defocus::yuvToBgr(yuv);
+        for (const auto preset : {defocus::Quality::Preset::Fast, defocus::Quality::Preset::Balanced,
+                                  defocus::Quality::Preset::High})
+            for (const auto kernel : {defocus::Quality::Hexagon::Rhombi, defocus::Quality::Hexagon::McIntosh})
+                for (const bool alwaysOn : {false, true}) {
+                    defocus::Settings settings;
+                    settings.depthScale = 5000;
+                    settings.lens.focusM = 1.0;
+                    settings.lens.fNumber = 1.4;
+                    settings.quality.preset = preset;
+                    settings.quality.hexagon = kernel;
+                    settings.quality.alwaysOn = alwaysOn;
+                    const std::string what = fmt::format(
+                        "{}, {}, {}, plan {}", layout == defocus::YuvImage::Layout::Nv12 ? "NV12" : "I420",
+                        defocus::qualityName(preset), kernel == defocus::Quality::Hexagon::Rhombi ? "rhombi" : "mcintosh",
+                        alwaysOn ? "off" : "on");
+                    std::optional<defocus::Filter> filter;
+                    try {
+                        filter.emplace(settings);
+                    } catch (const defocus::GlError& error) {
+                        GTEST_SKIP() << "no OpenGL 4.5: " << error.what();
+                    }
+                    for (const cv::Mat& d : {depth, flat}) {
+                        const cv::Mat expected = filter->process(converted, d);
+                        EXPECT_TRUE(identical(filter->process(yuv, d), expected))
+                            << what << (d.data == flat.data ? ", all in focus" : "");
+                    }
+                    if (preset != defocus::Quality::Preset::Balanced || kernel != defocus::Quality::Hexagon::Rhombi)
+                        continue;
+                    // In flight, and the contact sheet's frame processed again from the planes.
+                    const cv::Mat expected = filter->process(converted, depth);
+                    filter->submit(yuv, depth);
+                    filter->submit(yuv, flat);
+                    EXPECT_TRUE(identical(filter->receive().value(), expected)) << what << ", in flight";
+                    filter->receive();
+                    const cv::Mat out = filter->process(yuv, depth);
+                    filter->contactSheet();
+                    EXPECT_TRUE(identical(filter->process(yuv, depth), out)) << what << ", after a contact sheet";
+                }
+    }
+}

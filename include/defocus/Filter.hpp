@@ -29,6 +29,7 @@
 #include <opencv2/core.hpp>
 
 #include "defocus/Export.hpp"
+#include "defocus/Frame.hpp"
 #include "defocus/Settings.hpp"
 
 namespace defocus {
@@ -159,6 +160,11 @@ struct RendererInfo {
 /// GStreamer's GL library on a machine with no window system and no /dev/dri
 /// (gst_gl_display_egl_new_with_egl_display). Throws GlError where no context can be made.
 DEFOCUS_API void* eglDisplay(const ContextOptions& context = {});
+/// `image` as the filter sees it: CV_8UC3 BGR, each pixel from its own Y' and the Cb and Cr of its
+/// 2x2 block (nearest, as OpenCV's cvtColor and video players' fast paths take them), in 8-bit
+/// fixed point with the coefficients of its matrix and range (BT.601 limited: within one level of
+/// cv::cvtColor's COLOR_YUV2BGR_I420). Throws InputError for planes of the wrong type or size.
+DEFOCUS_API cv::Mat yuvToBgr(const YuvImage& image);
 /// The EGL devices of this machine; empty where EGL cannot enumerate them.
 DEFOCUS_API std::vector<EglDevice> eglDevices();
 /// Makes an OpenGL 4.5 context as a Filter would (no shaders compiled), says what it is and
@@ -205,6 +211,12 @@ public:
     /// between frames; 0 = unknown, taken as 1/30 s). Throws InputError for images it cannot
     /// take and SettingsError when an automatic focus comes out of range.
     cv::Mat process(const cv::Mat& color, const cv::Mat& depth, double timestampS = 0.0);
+    /// process() of colour as video decoders and cameras give it (YuvImage: I420 or NV12, its
+    /// planes views or not): the same bytes as process(yuvToBgr(color), depth, timestampS). On
+    /// a GPU the planes go up as they are (1.5 bytes a pixel instead of BGR's 3) and become
+    /// colour there; on a software renderer the CPU converts them. Throws InputError for planes
+    /// of the wrong type or size.
+    cv::Mat process(const YuvImage& color, const cv::Mat& depth, double timestampS = 0.0);
     /// process() for a frame in textures of the caller's context (ContextOptions::callerContext;
     /// otherwise it throws InputError): the same result as process() of the same images, byte for
     /// byte, into `frame.output` (Settings::output is taken as Srgb8). Call it on the thread where
@@ -238,6 +250,8 @@ public:
     /// process() and contactSheet() throw Error; reset() drops them. Not for a Filter on the
     /// caller's context (processTextures()).
     void submit(const cv::Mat& color, const cv::Mat& depth, double timestampS = 0.0);
+    /// submit() of Y'CbCr colour, as process() takes it; its planes are referenced until received.
+    void submit(const YuvImage& color, const cv::Mat& depth, double timestampS = 0.0);
     std::optional<cv::Mat> receive();
     /// Frames submitted and not yet received.
     std::size_t framesInFlight() const;

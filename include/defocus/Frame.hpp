@@ -2,7 +2,8 @@
 // defocus::Frame: one RGB-D frame as a source gives it and the filter takes it: colour, depth (in
 // metres, or in the units a 16-bit file or camera stored), when it was captured and where it
 // came from (for messages). defocus::Source gives them; the command line's sources and sinks pass
-// them along.
+// them along. defocus::YuvImage: colour as a video decoder or camera gives it, which the filter
+// also takes.
 #pragma once
 
 #include <cstddef>
@@ -32,6 +33,30 @@ struct Frame {
     std::string name;
     /// Units per metre of CV_16UC1 `depth` (> 0); 0 where `depth` is metres or empty.
     double depthScale = 0.0;
+};
+
+/// A colour image as video decoders and cameras give it: 8-bit Y'CbCr 4:2:0, planar (I420: Y, then
+/// Cb, then Cr) or semi-planar (NV12: Y, then Cb and Cr interleaved), each plane a cv::Mat that may
+/// view the caller's buffer (a GstVideoFrame's planes, a V4L2 buffer; rows may have padding).
+/// Filter::process() and submit() take it as they take BGR: on a GPU its planes go up as they are,
+/// half the bytes of BGR, and become colour there; where the CPU prepares depth (a software
+/// renderer) they become BGR on the CPU. Either way the filter sees yuvToBgr() of it.
+struct YuvImage {
+    enum class Layout {
+        I420, ///< u: Cb (CV_8UC1), v: Cr (CV_8UC1)
+        Nv12  ///< u: Cb and Cr interleaved (CV_8UC2), v: empty
+    };
+    /// The matrix from R'G'B' to Y'CbCr: BT.601 (standard-definition video, JPEG) or BT.709 (HD).
+    enum class Matrix { Bt601, Bt709 };
+    /// Limited ("TV", "studio"): Y' in 16..235, Cb and Cr in 16..240; full ("PC", JPEG): 0..255.
+    enum class Range { Limited, Full };
+
+    Layout layout = Layout::I420;
+    Matrix matrix = Matrix::Bt709;
+    Range range = Range::Limited;
+    cv::Mat y; ///< CV_8UC1 luma, the image's size
+    cv::Mat u; ///< chroma at half the width and height, rounded up (see Layout)
+    cv::Mat v;
 };
 
 /// `frame.depth` as CV_32FC1 metres: 16-bit depth divided by its depthScale (0 stays 0), metres
