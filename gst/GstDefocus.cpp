@@ -23,6 +23,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -789,6 +790,46 @@ cv::Mat wrap(GstVideoFrame* frame, int type)
                    GST_VIDEO_FRAME_PLANE_DATA(frame, 0), static_cast<size_t>(GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0)));
 }
 
+/// The Y'CbCr matrix and range of `info` where the filter takes its frames as they are (I420 or
+/// NV12 in BT.601 or BT.709); nullopt for every other format, which the colour pad converts.
+std::optional<defocus::YuvImage> yuvLayout(const GstVideoInfo& info)
+{
+    defocus::YuvImage yuv;
+    switch (GST_VIDEO_INFO_FORMAT(&info)) {
+    case GST_VIDEO_FORMAT_I420: yuv.layout = defocus::YuvImage::Layout::I420; break;
+    case GST_VIDEO_FORMAT_NV12: yuv.layout = defocus::YuvImage::Layout::Nv12; break;
+    default: return std::nullopt;
+    }
+    switch (info.colorimetry.matrix) {
+    case GST_VIDEO_COLOR_MATRIX_BT601: yuv.matrix = defocus::YuvImage::Matrix::Bt601; break;
+    case GST_VIDEO_COLOR_MATRIX_BT709: yuv.matrix = defocus::YuvImage::Matrix::Bt709; break;
+    default: return std::nullopt; // BT.2020, SMPTE 240M, ...: GStreamer's converter knows them
+    }
+    yuv.range = info.colorimetry.range == GST_VIDEO_COLOR_RANGE_0_255 ? defocus::YuvImage::Range::Full
+                                                                      : defocus::YuvImage::Range::Limited;
+    return yuv;
+}
+
+/// `frame` (I420 or NV12, yuvLayout() of its info) as the filter's YuvImage: its planes, no copy.
+defocus::YuvImage toYuv(GstVideoFrame* frame)
+{
+    defocus::YuvImage yuv = *yuvLayout(frame->info);
+    const int width = GST_VIDEO_FRAME_WIDTH(frame), height = GST_VIDEO_FRAME_HEIGHT(frame);
+    const cv::Size half((width + 1) / 2, (height + 1) / 2);
+    const auto plane = [&](guint i, cv::Size size, int type) {
+        return cv::Mat(size, type, GST_VIDEO_FRAME_PLANE_DATA(frame, i),
+                       static_cast<size_t>(GST_VIDEO_FRAME_PLANE_STRIDE(frame, i)));
+    };
+    yuv.y = plane(0, {width, height}, CV_8UC1);
+    if (yuv.layout == defocus::YuvImage::Layout::Nv12) {
+        yuv.u = plane(1, half, CV_8UC2);
+    } else {
+        yuv.u = plane(1, half, CV_8UC1);
+        yuv.v = plane(2, half, CV_8UC1);
+    }
+    return yuv;
+}
+
 /// `color` (the output's format, converted by the colour pad) as the filter's BGR or BGRx.
 cv::Mat toFilter(GstVideoFrame* color)
 {
@@ -976,8 +1017,8 @@ GstFlowReturn guarded(GstDefocus* self, InFlight& frame, Call&& call)
     return GST_FLOW_ERROR;
 }
 
-/// Submits `color` (the output's format) with `depth` to the filter, to come out with `pts`
-/// and `duration`; the frame joins the frames in flight.
+/// Submits `color` (the output's format, or I420 or NV12 as it came) with `depth` to the filter,
+/// to come out with `pts` and `duration`; the frame joins the frames in flight.
 GstFlowReturn submit(GstDefocus* self, GstVideoFrame* color, GstBuffer* depth, GstVideoInfo* depthInfo,
                      GstClockTime pts, GstClockTime duration)
 {
@@ -985,7 +1026,9 @@ GstFlowReturn submit(GstDefocus* self, GstVideoFrame* color, GstBuffer* depth, G
     const FrameSetup setup = setUpFrame(self, pts);
     defocus::Settings settings = setup.settings;
     // BGRx and BGRA come back as they go out, four bytes a pixel: no conversion on either side.
-    const GstVideoFormat format = GST_VIDEO_FRAME_FORMAT(color);
+    GST_OBJECT_LOCK(self);
+    const GstVideoFormat format = GST_VIDEO_INFO_FORMAT(&GST_VIDEO_AGGREGATOR(self)->info);
+    GST_OBJECT_UNLOCK(self);
     settings.output = format == GST_VIDEO_FORMAT_BGRx || format == GST_VIDEO_FORMAT_BGRA
                           ? defocus::Settings::Output::Srgb8Bgra
                           : defocus::Settings::Output::Srgb8;
@@ -1018,8 +1061,12 @@ GstFlowReturn submit(GstDefocus* self, GstVideoFrame* color, GstBuffer* depth, G
         GST_ELEMENT_ERROR(self, STREAM, FAILED, ("A colour or depth frame could not be mapped"), (nullptr));
         return GST_FLOW_ERROR;
     }
-    const GstFlowReturn ret = guarded(
-        self, frame, [&] { s.filter->submit(toFilter(&frame.color), depthOf(&frame.depth), setup.seconds); });
+    const GstFlowReturn ret = guarded(self, frame, [&] {
+        if (yuvLayout(frame.color.info))
+            s.filter->submit(toYuv(&frame.color), depthOf(&frame.depth), setup.seconds);
+        else
+            s.filter->submit(toFilter(&frame.color), depthOf(&frame.depth), setup.seconds);
+    });
     if (ret == GST_FLOW_OK)
         s.inFlight.push_back(frame);
     return ret;
@@ -1339,19 +1386,26 @@ GstFlowReturn aggregate(GstAggregator* agg, gboolean timeout)
             ret = renderGl(self, outbuf, colorBuffer, &colorInfo, s.depthFrame, &depthInfo);
         }
     } else {
-        // The colour in the output's format (the colour pad converts it), the depth as it came,
-        // submitted; the oldest frame in flight comes out when the filter holds its
+        // The colour in the output's format (the colour pad converts it), or I420 and NV12 as
+        // they came (the filter converts them, on the GPU where it has one), the depth as it
+        // came, submitted; the oldest frame in flight comes out when the filter holds its
         // kFramesInFlight, and every one when no colour frame waits behind this one (a frame is
         // never held for input that is not there: no latency added).
         auto* colorClass = GST_VIDEO_AGGREGATOR_PAD_GET_CLASS(colorPad);
         GstVideoFrame prepared{};
-        if (!colorClass->prepare_frame(colorPad, vagg, colorBuffer, &prepared) || !prepared.buffer) {
+        const bool asItCame = yuvLayout(colorInfo).has_value();
+        const bool mapped = asItCame ? gst_video_frame_map(&prepared, &colorInfo, colorBuffer, GST_MAP_READ)
+                                     : colorClass->prepare_frame(colorPad, vagg, colorBuffer, &prepared);
+        if (!mapped || !prepared.buffer) {
             GST_ELEMENT_ERROR(self, STREAM, FAILED, ("A colour or depth frame could not be mapped"), (nullptr));
             ret = GST_FLOW_ERROR;
         } else {
             ret = submit(self, &prepared, s.depthFrame, &depthInfo, pts, duration);
         }
-        colorClass->clean_frame(colorPad, vagg, &prepared);
+        if (asItCame && prepared.buffer)
+            gst_video_frame_unmap(&prepared);
+        else if (!asItCame)
+            colorClass->clean_frame(colorPad, vagg, &prepared);
         if (ret == GST_FLOW_OK)
             ret = pushReceived(self, !gst_aggregator_pad_has_buffer(color));
     }

@@ -243,6 +243,54 @@ TEST_F(GstDefocus, RgbxColourAndBigEndianDepthMatchTheLibrary)
     EXPECT_TRUE(identical(out, expected));
 }
 
+// Defects caught: I420 or NV12 converted by the colour pad on the CPU (GStreamer's converter
+// rounds and resamples the chroma otherwise) instead of given to the filter as it came, the
+// caps' matrix or range not passed on, an NV12 plane read as I420's. The filter's result of its
+// yuvToBgr() is the reference, byte for byte.
+TEST_F(GstDefocus, I420AndNv12GoToTheFilterAsTheyCame)
+{
+    struct Case {
+        const char* format;
+        const char* colorimetry;
+        defocus::YuvImage::Matrix matrix;
+        defocus::YuvImage::Range range;
+    };
+    using M = defocus::YuvImage::Matrix;
+    using R = defocus::YuvImage::Range;
+    for (const Case& c : {Case{"I420", "bt709", M::Bt709, R::Limited}, Case{"NV12", "bt601", M::Bt601, R::Limited},
+                          Case{"I420", "1:4:0:0", M::Bt601, R::Full}}) {
+        const cv::Size size = frame_.bgr.size();
+        cv::Mat i420;
+        cv::cvtColor(frame_.bgr, i420, cv::COLOR_BGR2YUV_I420); // Y, Cb, Cr packed: GStreamer's I420 here
+        defocus::YuvImage yuv;
+        yuv.matrix = c.matrix;
+        yuv.range = c.range;
+        yuv.y = i420.rowRange(0, size.height);
+        const cv::Mat cb(size.height / 2, size.width / 2, CV_8UC1, i420.ptr(size.height));
+        const cv::Mat cr(size.height / 2, size.width / 2, CV_8UC1, i420.ptr(size.height) + cb.total());
+        cv::Mat packed = i420;
+        if (std::string(c.format) == "NV12") {
+            yuv.layout = defocus::YuvImage::Layout::Nv12;
+            cv::merge(std::vector<cv::Mat>{cb, cr}, yuv.u);
+            packed = cv::Mat(size.height * 3 / 2, size.width, CV_8UC1);
+            yuv.y.copyTo(packed.rowRange(0, size.height));
+            cv::Mat(size.height / 2, size.width, CV_8UC1, yuv.u.data).copyTo(packed.rowRange(size.height, packed.rows));
+        } else {
+            yuv.u = cb;
+            yuv.v = cr;
+        }
+        Element e(kLens);
+        gst_harness_set_src_caps_str(e.color, (caps(c.format, size) + ",colorimetry=" + c.colorimetry).c_str());
+        gst_harness_set_src_caps_str(e.depth, caps("GRAY16_LE", frame_.depth16.size()).c_str());
+        gst_harness_set_sink_caps_str(e.color, "video/x-raw,format=BGR");
+        ASSERT_EQ(gst_harness_push(e.color, bufferOf(packed, 0)), GST_FLOW_OK);
+        ASSERT_EQ(gst_harness_push(e.depth, bufferOf(frame_.depth16, 0)), GST_FLOW_OK);
+        const cv::Mat out = matOf(gst_harness_pull(e.color), size, CV_8UC3);
+        EXPECT_TRUE(identical(out, library(lensSettings(), defocus::yuvToBgr(yuv), frame_.depth16)))
+            << c.format << " " << c.colorimetry;
+    }
+}
+
 // Defect caught: an all-in-focus frame changed on its way through (a colour conversion that
 // rounds, an sRGB round trip, the alpha lost): with no blur the output is the input, exactly.
 TEST_F(GstDefocus, InFocusPassesThroughBitExact)
