@@ -27,6 +27,91 @@ double threadCpuMs()
     return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
+/// `bgr` as I420 planes (OpenCV's BT.601, limited range).
+YuvImage i420Of(const cv::Mat& bgr)
+{
+    cv::Mat packed;
+    cv::cvtColor(bgr, packed, cv::COLOR_BGR2YUV_I420);
+    const int w = bgr.cols, h = bgr.rows;
+    YuvImage yuv;
+    yuv.matrix = YuvImage::Matrix::Bt601;
+    yuv.y = packed.rowRange(0, h);
+    yuv.u = cv::Mat(h / 2, w / 2, CV_8UC1, packed.ptr(h));
+    yuv.v = cv::Mat(h / 2, w / 2, CV_8UC1, packed.ptr(h) + (w / 2) * (h / 2));
+    return yuv;
+}
+
+/// --versus-i420: the table of I420 in flight against BGR in flight, per size.
+int runVersusI420(const ThroughputOptions& options, const std::vector<Frame>& clip, Filter& filter)
+{
+    fmt::print("{:>11} | {:>22} | {:>22} | {:>9} | {:>9}\n", "size", "BGR ms (fps)", "I420 ms (fps)", "I420/BGR",
+               "CPU ms");
+    int status = kExitDone;
+    for (const cv::Size size : options.sizes) {
+        std::vector<YuvImage> yuv;
+        std::vector<cv::Mat> bgr, depth;
+        for (const Frame& f : clip) {
+            cv::Mat color, d;
+            cv::resize(f.color, color, size, 0, 0, cv::INTER_AREA);
+            cv::resize(f.depth, d, size, 0, 0, cv::INTER_NEAREST);
+            yuv.push_back(i420Of(color));
+            bgr.push_back(yuvToBgr(yuv.back())); // what the filter makes of the planes: the same frames
+            depth.push_back(d);
+        }
+        const auto timed = [&](bool planes, std::vector<cv::Mat>* outputs, double& cpuMs) {
+            filter.reset();
+            const auto start = Clock::now();
+            const double cpu = threadCpuMs();
+            const auto take = [&] {
+                cv::Mat out = *filter.receive();
+                if (outputs)
+                    outputs->push_back(out);
+            };
+            for (int i = 0; i < options.frames; ++i) {
+                const std::size_t k = static_cast<std::size_t>(i) % clip.size();
+                if (planes)
+                    filter.submit(yuv[k], depth[k]);
+                else
+                    filter.submit(bgr[k], depth[k]);
+                if (filter.framesInFlight() >= Filter::kFramesInFlight)
+                    take();
+            }
+            while (filter.framesInFlight() > 0)
+                take();
+            cpuMs = (threadCpuMs() - cpu) / options.frames;
+            return std::chrono::duration<double, std::milli>(Clock::now() - start).count() / options.frames;
+        };
+        filter.process(bgr[0], depth[0]); // warm: targets of this size
+        filter.process(yuv[0], depth[0]);
+        std::vector<double> bgrMs, yuvMs, bgrCpu, yuvCpu;
+        std::vector<cv::Mat> bgrOut, yuvOut;
+        for (int pass = 0; pass < options.passes; ++pass) {
+            double cpu = 0.0;
+            bgrMs.push_back(timed(false, pass == 0 ? &bgrOut : nullptr, cpu));
+            bgrCpu.push_back(cpu);
+            yuvMs.push_back(timed(true, pass == 0 ? &yuvOut : nullptr, cpu));
+            yuvCpu.push_back(cpu);
+        }
+        for (std::size_t i = 0; i < bgrOut.size(); ++i) {
+            cv::Mat diff;
+            cv::absdiff(bgrOut[i], yuvOut[i], diff);
+            if (cv::countNonZero(diff.reshape(1)) != 0) {
+                fmt::print(stderr, "defocus-bench: error: {}x{} frame {}: I420 differs from its BGR\n", size.width,
+                           size.height, i);
+                status = kExitBadInput;
+            }
+        }
+        const double b = median(bgrMs), y = median(yuvMs);
+        fmt::print("{:>11} | {:>9.2f} ({:>7.1f} fps) | {:>9.2f} ({:>7.1f} fps) | {:>9.3f} | {:>4.1f} {:>4.1f}\n",
+                   fmt::format("{}x{}", size.width, size.height), b, 1e3 / b, y, 1e3 / y, y / b, median(bgrCpu),
+                   median(yuvCpu));
+    }
+    fmt::print("ms: wall per frame with {} in flight, median of the passes; CPU ms: the calling thread's CPU time "
+               "per frame, BGR then I420\n",
+               Filter::kFramesInFlight);
+    return status;
+}
+
 } // namespace
 
 int runThroughput(const ThroughputOptions& options)
@@ -52,6 +137,8 @@ int runThroughput(const ThroughputOptions& options)
     Filter filter(settings);
     fmt::print("{} frames of {} per pass, {} passes per way, interleaved; {} preset; on {}\n", options.frames,
                options.data, options.passes, options.preset, filter.renderer());
+    if (options.versusI420)
+        return runVersusI420(options, clip, filter);
     fmt::print("{:>11} | {:>22} | {:>22} | {:>9} | {:>9}\n", "size", "one at a time ms (fps)",
                fmt::format("{} in flight ms (fps)", Filter::kFramesInFlight), "new/old", "CPU ms");
     int status = kExitDone;

@@ -4,6 +4,7 @@
 // the calling thread's CPU time per frame in each (its own work: what it spends not waiting).
 //   defocus-bench throughput                                     (640x480 and 1920x1080, balanced)
 //   defocus-bench throughput --sizes 3840x2160 --frames 60 --passes 5 --quality high
+//   defocus-bench throughput --versus-i420                       (colour as I420 planes against BGR)
 #pragma once
 
 #include <string>
@@ -19,6 +20,9 @@ struct ThroughputOptions {
     std::string preset = "balanced";                        ///< quality preset
     int frames = 30;                                        ///< frames per timed pass
     int passes = 3;                                         ///< passes per mode, interleaved
+    /// Instead: frames in flight with the colour as I420 planes against the same frames as BGR
+    /// (yuvToBgr() of them), interleaved, and that both give the same bytes.
+    bool versusI420 = false;
 };
 
 /// Prints a table per size and checks that both ways give the same bytes; returns the exit

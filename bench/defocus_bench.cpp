@@ -684,6 +684,9 @@ CLI::App* declareThroughput(CLI::App& app, defocus::ThroughputOptions& o)
     sub->add_option("--passes", o.passes, "Timed passes per way, interleaved")
         ->capture_default_str()
         ->check(cli::between(1, 1000));
+    sub->add_flag("--versus-i420", o.versusI420,
+                  "Instead: frames in flight with the colour as I420 planes against the same frames as BGR, "
+                  "interleaved, and a check that both give the same bytes");
     return sub;
 }
 
