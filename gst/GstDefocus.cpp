@@ -39,8 +39,8 @@ GST_DEBUG_CATEGORY_STATIC(gst_defocus_debug);
 namespace {
 
 /// A colour frame submitted to the filter and not yet received: the element's own mappings of
-/// its colour (as the colour pad prepared it) and of its depth, which the filter reads until the
-/// frame is received, and what its output buffer takes.
+/// its colour (as the colour pad prepared it, or I420 or NV12 as it came) and of its depth, which
+/// the filter reads until the frame is received, and what its output buffer takes.
 struct InFlight {
     GstVideoFrame color{}, depth{};
     GstClockTime pts = GST_CLOCK_TIME_NONE, duration = GST_CLOCK_TIME_NONE;
