@@ -38,6 +38,7 @@ struct SrcState {
     int height = 480;
     double fps = 30.0;
     gint64 numBuffers = -1;
+    int readThreads = -1; ///< -1: defocus::defaultReadThreads()
 
     // Opened in READY->PAUSED, used by the streaming thread, closed in PAUSED->READY.
     std::unique_ptr<defocus::Source> source;
@@ -81,6 +82,7 @@ enum Property {
     PROP_HEIGHT,
     PROP_FPS,
     PROP_NUM_BUFFERS,
+    PROP_READ_THREADS,
 };
 
 GstStaticPadTemplate colorTemplate = GST_STATIC_PAD_TEMPLATE(
@@ -331,7 +333,10 @@ bool openSource(GstDefocusSrc* self)
         settings.width = st.width;
         settings.height = st.height;
         settings.fps = st.fps;
+        settings.readThreads = st.readThreads < 0 ? defocus::defaultReadThreads() : static_cast<std::size_t>(st.readThreads);
     }
+    GST_INFO_OBJECT(self, "a recorded clip is decoded on %zu thread(s) ahead of the streaming thread",
+                    settings.readThreads);
     const defocus::gst::LibraryCall call(GST_ELEMENT(self));
     if (settings.input.empty()) {
         GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("defocussrc: no location given (a TUM folder, image folder, "
@@ -460,6 +465,7 @@ void setProperty(GObject* object, guint id, const GValue* value, GParamSpec* spe
     case PROP_HEIGHT: st.height = g_value_get_int(value); break;
     case PROP_FPS: st.fps = g_value_get_double(value); break;
     case PROP_NUM_BUFFERS: st.numBuffers = g_value_get_int64(value); break;
+    case PROP_READ_THREADS: st.readThreads = g_value_get_int(value); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, spec);
     }
 }
@@ -477,6 +483,7 @@ void getProperty(GObject* object, guint id, GValue* value, GParamSpec* spec)
     case PROP_HEIGHT: g_value_set_int(value, st.height); break;
     case PROP_FPS: g_value_set_double(value, st.fps); break;
     case PROP_NUM_BUFFERS: g_value_set_int64(value, st.numBuffers); break;
+    case PROP_READ_THREADS: g_value_set_int(value, st.readThreads); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, spec);
     }
 }
@@ -538,6 +545,12 @@ static void gst_defocus_src_class_init(GstDefocusSrcClass* klass)
         gobject, PROP_NUM_BUFFERS,
         g_param_spec_int64("num-buffers", "num-buffers", "Frames to give before the end of stream (-1 = all)", -1,
                            G_MAXINT64, -1, kFlags));
+    g_object_class_install_property(
+        gobject, PROP_READ_THREADS,
+        g_param_spec_int("read-threads", "read-threads",
+                         "Threads decoding a recorded clip ahead of the streaming thread, several frames at once "
+                         "(0 = on the streaming thread; -1 = the CPUs this process may use less one, at most 8)",
+                         -1, 64, -1, kFlags));
 
     gst_element_class_add_static_pad_template(element, &colorTemplate);
     gst_element_class_add_static_pad_template(element, &depthTemplate);

@@ -13,6 +13,7 @@
 #include "filter/gl/EglContext.hpp"
 #include "filter/gl/Program.hpp"
 #include "sources/FrameSource.hpp"
+#include "sources/ReadAheadSource.hpp"
 #include "sources/SyntheticSource.hpp"
 
 namespace defocus {
@@ -100,6 +101,14 @@ Source::Source(const SourceSettings& settings) : impl_(std::make_unique<Impl>())
     } catch (const SourceError& error) {
         throw SourceReadError(error.what());
     }
+    if (settings.readThreads > 0 && !impl_->source->isLive())
+        impl_->source = std::make_unique<ReadAheadSource>(std::move(impl_->source), settings.readThreads + 1,
+                                                          settings.readThreads);
+}
+
+std::size_t defaultReadThreads(std::size_t clips)
+{
+    return ReadAheadSource::defaultThreads(clips);
 }
 
 Source::~Source() = default;

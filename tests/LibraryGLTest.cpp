@@ -14,7 +14,11 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <set>
 #include <thread>
+
+#include <sys/inotify.h>
+#include <unistd.h>
 
 #include <defocus/defocus.hpp>
 #include <gtest/gtest.h>
@@ -763,4 +767,54 @@ TEST(LibraryYuv, YuvInIsTheResultOfItsBgrOnEveryPreset)
                     EXPECT_TRUE(identical(filter->process(yuv, depth), out)) << what << ", after a contact sheet";
                 }
     }
+}
+
+// Defects caught: SourceSettings::readThreads not reaching the reading (no frame is read before
+// next() asks: the reads of frames 1 and 2 are watched for with inotify, right after the Source is
+// made), and frames decoded ahead given in another order, paired with another depth or changed.
+TEST(LibrarySource, ReadThreadsDecodeAheadAndGiveTheClipsFramesAsTheyAre)
+{
+    const fs::path dir = defocus::test::scratchDir("LibrarySource_read_threads");
+    fs::create_directories(dir / "colour");
+    fs::create_directories(dir / "depth");
+    for (int k = 0; k < 3; ++k) {
+        const Pair pair = bundled(4 + k);
+        fs::copy_file(pair.color, dir / "colour" / fmt::format("{:04}.png", k));
+        fs::copy_file(pair.depth, dir / "depth" / fmt::format("{:04}.png", k));
+    }
+    defocus::SourceSettings settings;
+    settings.input = (dir / "colour").string();
+    settings.depth = (dir / "depth").string();
+    settings.depthScale = 5000;
+    const int watch = inotify_init1(IN_NONBLOCK);
+    ASSERT_GE(watch, 0);
+    ASSERT_GE(inotify_add_watch(watch, (dir / "colour").c_str(), IN_CLOSE_NOWRITE), 0);
+    settings.readThreads = 2;
+    defocus::Source ahead(settings);
+    std::set<std::string> read;
+    for (int i = 0; i < 1000 && !(read.count("0001.png") && read.count("0002.png")); ++i) {
+        alignas(inotify_event) char buffer[4096];
+        for (ssize_t n; (n = ::read(watch, buffer, sizeof buffer)) > 0;)
+            for (char* at = buffer; at < buffer + n;) {
+                const auto* event = reinterpret_cast<const inotify_event*>(at);
+                if (event->len > 0)
+                    read.insert(event->name);
+                at += sizeof(inotify_event) + event->len;
+            }
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ::close(watch);
+    EXPECT_TRUE(read.count("0001.png") && read.count("0002.png")) << "frames 1 and 2 not read ahead of next()";
+    settings.readThreads = 0;
+    defocus::Source inTurn(settings);
+    for (int k = 0; k < 3; ++k) {
+        const auto a = ahead.next(), b = inTurn.next();
+        ASSERT_TRUE(a && b) << k;
+        EXPECT_TRUE(identical(a->color, b->color)) << k;
+        EXPECT_TRUE(identical(a->depth, b->depth)) << k;
+        EXPECT_EQ(a->name, b->name);
+        EXPECT_EQ(a->index, b->index);
+    }
+    EXPECT_FALSE(ahead.next());
+    EXPECT_FALSE(inTurn.next());
 }

@@ -19,7 +19,7 @@ clip=$root/data/tum_fr1_rpy
 gst-inspect-1.0 defocussrc >"$work/inspect.txt" 2>"$work/inspect.err" || fail "gst-inspect-1.0 defocussrc failed"
 [ ! -s "$work/inspect.err" ] || fail "gst-inspect-1.0 wrote to stderr: $(cat "$work/inspect.err")"
 ! grep -qE "WARNING|CRITICAL|WARN " "$work/inspect.txt" || fail "gst-inspect-1.0 output has warnings"
-for property in location depth-location input-depth-scale depth-scale width height fps num-buffers; do
+for property in location depth-location input-depth-scale depth-scale width height fps num-buffers read-threads; do
   grep -q "^  $property *:" "$work/inspect.txt" || fail "property $property missing"
 done
 for pad in color depth; do
@@ -37,6 +37,16 @@ gst-launch-1.0 -q defocussrc name=s location="$clip" depth-scale=5000 \
 "$cli" "$clip" -o "$work/cli/" --focus 1.0 --f-number 1.4 -q >/dev/null
 same_frames_as_cli "$work/gst" "$work/cli" "$work" "defocussrc ! defocus"
 echo "defocussrc-test: $frames frames of the TUM folder through defocussrc ! defocus = defocus CLI, byte for byte"
+# The same with the clip decoded on three threads ahead of the streaming thread: the property
+# reaches the source (its info line) and the frames are the same, in order.
+mkdir -p "$work/gst3"
+GST_DEBUG=defocussrc:4 gst-launch-1.0 -q defocussrc name=s location="$clip" depth-scale=5000 read-threads=3 \
+  defocus name=d autofocus=false focus=1.0 f-number=1.4 depth-scale=5000 ! videoconvert ! pngenc ! \
+  multifilesink location="$work/gst3/%06d.png" \
+  s.color ! queue ! d.color  s.depth ! queue ! d.depth >/dev/null 2>"$work/threads.log" || fail "read-threads=3 failed"
+grep -q "decoded on 3 thread(s) ahead" "$work/threads.log" || fail "read-threads=3 did not reach the source"
+same_frames_as_cli "$work/gst3" "$work/cli" "$work" "defocussrc read-threads=3 ! defocus"
+echo "defocussrc-test: read-threads=3 gives the same $frames frames"
 
 # 3. num-buffers: that many frames on each pad, then the end of the stream.
 gst-launch-1.0 -q defocussrc name=s location="$clip" num-buffers=3 \

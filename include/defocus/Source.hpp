@@ -73,7 +73,17 @@ struct SourceSettings {
     /// exact depth, 30 Hz, with OpenGL on a context of the Source's own (on `context`'s device).
     std::optional<SyntheticClip> synthetic;
     ContextOptions context;
+    /// A recorded clip's frames decoded ahead of next() on this many threads of the Source's own,
+    /// several at once where the input allows (a TUM folder, a folder pair), in the clip's order,
+    /// an error after the frames before it; 0: each frame read in next(). defaultReadThreads() is
+    /// what the command line takes. A camera's frames are read when asked whatever this says.
+    std::size_t readThreads = 0;
 };
+
+/// Threads for decoding a recorded clip ahead, where `clips` clips are read at once: the CPUs
+/// this process may run on (its affinity: a Slurm job's or taskset's) less one, shared among the
+/// clips, at most 8, at least one: the command line's --read-threads 0.
+DEFOCUS_API std::size_t defaultReadThreads(std::size_t clips = 1);
 
 /// One frame as the source gives it (the same type Filter::process takes apart).
 using SourceFrame = Frame;
