@@ -753,9 +753,9 @@ int runRead(const ReadOptions& o)
     // One pass unmeasured first: every number of threads then reads from the page cache.
     const auto readAll = [&](std::size_t threads) {
         const auto start = std::chrono::steady_clock::now();
-        ReadAheadSource ahead(openSource(source), threads + 1, threads);
+        const auto ahead = ReadAheadSource::onThreads(openSource(source), threads);
         std::size_t frames = 0;
-        while (ahead.next())
+        while (ahead->next())
             ++frames;
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         return std::pair{frames, ms / static_cast<double>(std::max<std::size_t>(frames, 1))};

@@ -335,8 +335,6 @@ bool openSource(GstDefocusSrc* self)
         settings.fps = st.fps;
         settings.readThreads = st.readThreads < 0 ? defocus::defaultReadThreads() : static_cast<std::size_t>(st.readThreads);
     }
-    GST_INFO_OBJECT(self, "a recorded clip is decoded on %zu thread(s) ahead of the streaming thread",
-                    settings.readThreads);
     const defocus::gst::LibraryCall call(GST_ELEMENT(self));
     if (settings.input.empty()) {
         GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("defocussrc: no location given (a TUM folder, image folder, "
@@ -346,6 +344,9 @@ bool openSource(GstDefocusSrc* self)
     try {
         st.source = std::make_unique<defocus::Source>(settings);
         st.live = st.source->isLive();
+        if (!st.live)
+            GST_INFO_OBJECT(self, "a recorded clip is decoded on %zu thread(s) ahead of the streaming thread",
+                            settings.readThreads);
         // The first frame fixes the caps; reading it here makes a bad input fail the state change.
         if (!st.live) {
             st.first = st.source->next();

@@ -102,8 +102,7 @@ Source::Source(const SourceSettings& settings) : impl_(std::make_unique<Impl>())
         throw SourceReadError(error.what());
     }
     if (settings.readThreads > 0 && !impl_->source->isLive())
-        impl_->source = std::make_unique<ReadAheadSource>(std::move(impl_->source), settings.readThreads + 1,
-                                                          settings.readThreads);
+        impl_->source = ReadAheadSource::onThreads(std::move(impl_->source), settings.readThreads);
 }
 
 std::size_t defaultReadThreads(std::size_t clips)

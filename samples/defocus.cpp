@@ -100,6 +100,12 @@ struct Options : cli::LensNames, cli::QualityNames {
     std::string report;        ///< --report FILE.json of a single run
 };
 
+/// A --read-threads or --write-threads value: 0 is the CPUs this process may use less one.
+std::size_t threadsOrDefault(std::size_t threads)
+{
+    return threads > 0 ? threads : ReadAheadSource::defaultThreads();
+}
+
 ContextOptions contextOptions(const Options& options)
 {
     ContextOptions context;
@@ -114,8 +120,7 @@ int printInfo(const Options& options)
                    d.drmFile.empty() ? "" : ", " + d.drmFile, d.cudaId ? fmt::format(", CUDA device {}", *d.cudaId) : "");
     const RendererInfo info = probeRenderer(contextOptions(options));
     const std::size_t cpus = ReadAheadSource::usableCpus();
-    const std::size_t threads = options.readThreads > 0 ? options.readThreads : ReadAheadSource::defaultThreads();
-    const std::size_t writing = options.writeThreads > 0 ? options.writeThreads : ReadAheadSource::defaultThreads();
+    const std::size_t threads = threadsOrDefault(options.readThreads), writing = threadsOrDefault(options.writeThreads);
     fmt::print("EGL platform: {}{}\nEGL vendor:   {}\nEGL version:  {}\nGL vendor:    {}\nGL renderer:  {}\n"
                "GL version:   {}\nGPU timers:   {}\nDepth prep:   {}\nPrecision:    {} (the presets', the renderer's)\n"
                "Passes:       {} shaders\nReading:      {} thread{} ahead of the filter ({} CPU{} this process may use)\n"
@@ -640,7 +645,7 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
     sinkOptions.linearSequence = options.imageFormat == "exr";
     sinkOptions.overwrite = options.overwrite;
     sinkOptions.codec = options.codec;
-    sinkOptions.threads = options.writeThreads > 0 ? options.writeThreads : ReadAheadSource::defaultThreads();
+    sinkOptions.threads = threadsOrDefault(options.writeThreads);
     std::unique_ptr<FrameSink> sink = openSink(sinkOptions);
     if (const auto* sequence = dynamic_cast<ImageSequenceSink*>(sink.get()))
         spdlog::debug("encoding the frames on {} thread{}", sequence->threads(), sequence->threads() == 1 ? "" : "s");
@@ -654,8 +659,8 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
     if (!virtualCamera)
         sink = std::make_unique<BackgroundSink>(std::move(sink));
     if (!source->isLive() && !demo) {
-        const std::size_t threads = options.readThreads > 0 ? options.readThreads : ReadAheadSource::defaultThreads();
-        source = std::make_unique<ReadAheadSource>(std::move(source), threads + 1, threads);
+        const std::size_t threads = threadsOrDefault(options.readThreads);
+        source = ReadAheadSource::onThreads(std::move(source), threads);
         spdlog::debug("reading ahead on {} thread{}", threads, threads == 1 ? "" : "s");
     }
     // A camera to a virtual camera: never make the camera wait, drop what the filter cannot keep up with.

@@ -108,8 +108,7 @@ int run(const Options& o)
     const auto readAhead = [live](std::unique_ptr<FrameSource> opened) -> std::unique_ptr<FrameSource> {
         if (live)
             return opened;
-        const std::size_t threads = ReadAheadSource::defaultThreads();
-        return std::make_unique<ReadAheadSource>(std::move(opened), threads + 1, threads);
+        return ReadAheadSource::onThreads(std::move(opened), ReadAheadSource::defaultThreads());
     };
     source = readAhead(std::move(source));
     const double sourceFps = source->frameRate() > 0.0 ? source->frameRate() : 30.0;

@@ -32,6 +32,11 @@ ReadAheadSource::~ReadAheadSource()
         thread.join();
 }
 
+std::unique_ptr<ReadAheadSource> ReadAheadSource::onThreads(std::unique_ptr<FrameSource> source, std::size_t threads)
+{
+    return std::make_unique<ReadAheadSource>(std::move(source), threads + 1, threads);
+}
+
 std::size_t ReadAheadSource::usableCpus()
 {
     cpu_set_t allowed;

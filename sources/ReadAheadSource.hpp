@@ -40,6 +40,10 @@ public:
     double frameRate() const override { return frameRate_; }
     std::string describe() const override { return describe_; }
 
+    /// `source` read on `threads` threads (>= 1), one frame more than threads ahead: every thread
+    /// busy while the caller takes a frame. What the programs and the library's Source use.
+    static std::unique_ptr<ReadAheadSource> onThreads(std::unique_ptr<FrameSource> source, std::size_t threads);
+
     /// Threads for decoding a recorded clip ahead of the filter, where `clips` clips run at once:
     /// the CPUs this process may run on (its affinity: a Slurm job's or taskset's, not the
     /// machine's) less one for the caller, shared among the clips, at most 8, at least one.
