@@ -392,7 +392,10 @@ struct Pipeline::Impl {
                 continue;
             const bool pair = planes[i]->channels() == 2;
             ensureTexture(f.yuvPlanes[i], pair ? GL_RG8UI : GL_R8UI, planes[i]->size(), kNames[i]);
-            up(f.yuvPlanes[i], pair ? GL_RG_INTEGER : GL_RED_INTEGER, GL_UNSIGNED_BYTE, *planes[i]);
+            // Planes go up whole rows at a time: a view with padded rows, copied here (the CPU's
+            // conversion reads it as it is).
+            up(f.yuvPlanes[i], pair ? GL_RG_INTEGER : GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+               planes[i]->isContinuous() ? *planes[i] : planes[i]->clone());
         }
         if (!f.colorBytesTarget)
             f.colorBytesTarget = gl::Framebuffer(f.colorBytes, "input colour, bytes");
@@ -493,14 +496,7 @@ void Pipeline::Impl::begin(FrameContext& f, const Frame& frame, const LensSettin
     f.frameStart = Clock::now();
     f.size = yuv ? yuv->y.size() : frame.color.size();
     f.color = frame.color;
-    f.yuv = {};
-    if (yuv) {
-        // Planes go up whole rows at a time: a view with padded rows is copied.
-        f.yuv = *yuv;
-        for (cv::Mat* plane : {&f.yuv.y, &f.yuv.u, &f.yuv.v})
-            if (!plane->empty() && !plane->isContinuous())
-                *plane = plane->clone();
-    }
+    f.yuv = yuv ? *yuv : YuvImage{};
     f.depthInput = frame.depth;
     f.depthUnits = depthUnitsPerMetre;
     CV_Assert(f.depthInput.empty() || f.depthInput.type() == (f.depthUnits > 0.0 ? CV_16UC1 : CV_32FC1));
