@@ -246,6 +246,10 @@ struct Filter::Impl {
     /// submit() without its check: the frame begun, the one submitted before finished and its
     /// read queued, the frame queued into inFlight.
     void submitFrame(const cv::Mat& color, const cv::Mat& depth, double timestampS, const YuvImage* yuv = nullptr);
+    /// process(): with no frame in flight, submitFrame() then receiveFrame().
+    cv::Mat processAlone(const cv::Mat& color, const cv::Mat& depth, double timestampS, const YuvImage* yuv);
+    /// submit(): submitFrame() on a Filter with a context of its own.
+    void submitOwnContext(const cv::Mat& color, const cv::Mat& depth, double timestampS, const YuvImage* yuv);
     /// receive() of a frame in flight (there must be one).
     cv::Mat receiveFrame();
     /// The pipeline's oldest begun frame (`entry`'s) planned and its passes run, its read queued.
@@ -448,24 +452,24 @@ Frame Filter::Impl::admit(const cv::Mat& color, const cv::Mat& depth, double tim
     return frame;
 }
 
+cv::Mat Filter::Impl::processAlone(const cv::Mat& color, const cv::Mat& depth, double timestampS,
+                                    const YuvImage* yuv)
+{
+    if (!inFlight.empty())
+        throw Error(fmt::format("defocus::Filter::process(): {} frames in flight; receive() them first",
+                                inFlight.size()));
+    submitFrame(color, depth, timestampS, yuv);
+    return receiveFrame();
+}
+
 cv::Mat Filter::process(const cv::Mat& color, const cv::Mat& depth, double timestampS)
 {
-    Impl& p = *impl_;
-    if (!p.inFlight.empty())
-        throw Error(fmt::format("defocus::Filter::process(): {} frames in flight; receive() them first",
-                                p.inFlight.size()));
-    p.submitFrame(color, depth, timestampS);
-    return p.receiveFrame();
+    return impl_->processAlone(color, depth, timestampS, nullptr);
 }
 
 cv::Mat Filter::process(const YuvImage& color, const cv::Mat& depth, double timestampS)
 {
-    Impl& p = *impl_;
-    if (!p.inFlight.empty())
-        throw Error(fmt::format("defocus::Filter::process(): {} frames in flight; receive() them first",
-                                p.inFlight.size()));
-    p.submitFrame({}, depth, timestampS, &color);
-    return p.receiveFrame();
+    return impl_->processAlone({}, depth, timestampS, &color);
 }
 
 cv::Mat yuvToBgr(const YuvImage& image)
@@ -579,18 +583,22 @@ cv::Mat Filter::Impl::receiveFrame()
     return image;
 }
 
+void Filter::Impl::submitOwnContext(const cv::Mat& color, const cv::Mat& depth, double timestampS,
+                                    const YuvImage* yuv)
+{
+    if (!context)
+        throw Error("defocus::Filter::submit(): frames in GL textures go through processTextures()");
+    submitFrame(color, depth, timestampS, yuv);
+}
+
 void Filter::submit(const cv::Mat& color, const cv::Mat& depth, double timestampS)
 {
-    if (!impl_->context)
-        throw Error("defocus::Filter::submit(): frames in GL textures go through processTextures()");
-    impl_->submitFrame(color, depth, timestampS);
+    impl_->submitOwnContext(color, depth, timestampS, nullptr);
 }
 
 void Filter::submit(const YuvImage& color, const cv::Mat& depth, double timestampS)
 {
-    if (!impl_->context)
-        throw Error("defocus::Filter::submit(): frames in GL textures go through processTextures()");
-    impl_->submitFrame({}, depth, timestampS, &color);
+    impl_->submitOwnContext({}, depth, timestampS, &color);
 }
 
 std::optional<cv::Mat> Filter::receive()
