@@ -26,6 +26,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "tests/ImageCompare.hpp"
+#include "tests/YuvPlanes.hpp"
 #include "tests/TestSupport.hpp"
 
 namespace {
@@ -51,6 +52,21 @@ Pair bundled(int line)
 }
 
 using defocus::test::identical;
+
+/// The bundled clip's lens (focus 1 m, f/1.4, 5000 units per metre) with `preset` and `kernel`:
+/// the settings the tests that go over every preset and both kernels filter with.
+defocus::Settings presetSettings(defocus::Quality::Preset preset, defocus::Quality::Hexagon kernel)
+{
+    defocus::Settings settings;
+    settings.depthScale = 5000;
+    settings.lens.focusM = 1.0;
+    settings.lens.fNumber = 1.4;
+    settings.quality.preset = preset;
+    settings.quality.hexagon = kernel;
+    return settings;
+}
+using defocus::test::opencvYuv;
+using defocus::test::packedPlanes;
 
 class Library : public ::testing::Test {
 protected:
@@ -502,12 +518,7 @@ TEST(LibraryInFlight, FramesInFlightAreTheFramesOneAtATime)
     for (const auto preset : {defocus::Quality::Preset::Fast, defocus::Quality::Preset::Balanced,
                               defocus::Quality::Preset::High})
         for (const auto kernel : {defocus::Quality::Hexagon::Rhombi, defocus::Quality::Hexagon::McIntosh}) {
-            defocus::Settings settings;
-            settings.depthScale = 5000;
-            settings.lens.focusM = 1.0;
-            settings.lens.fNumber = 1.4;
-            settings.quality.preset = preset;
-            settings.quality.hexagon = kernel;
+            defocus::Settings settings = presetSettings(preset, kernel);
             const std::string what = std::string(defocus::qualityName(preset)) +
                                      (kernel == defocus::Quality::Hexagon::Rhombi ? ", rhombi" : ", mcintosh");
             std::optional<defocus::Filter> serial, pipelined;
@@ -583,29 +594,6 @@ TEST_F(Library, BgrxInAndBgraOutAreTheBgrFramesResult)
 
 namespace {
 
-/// `bgr` as Y'CbCr 4:2:0 planes by OpenCV (BT.601, limited range): I420, or NV12.
-defocus::YuvImage opencvYuv(const cv::Mat& bgr, defocus::YuvImage::Layout layout)
-{
-    const bool nv12 = layout == defocus::YuvImage::Layout::Nv12;
-    cv::Mat i420;
-    cv::cvtColor(bgr, i420, cv::COLOR_BGR2YUV_I420); // Y rows, then Cb, then Cr, each packed
-    const int w = bgr.cols, h = bgr.rows;
-    defocus::YuvImage yuv;
-    yuv.layout = layout;
-    yuv.matrix = defocus::YuvImage::Matrix::Bt601;
-    yuv.range = defocus::YuvImage::Range::Limited;
-    yuv.y = i420.rowRange(0, h).clone();
-    const cv::Mat cb = cv::Mat(h / 2, w / 2, CV_8UC1, i420.ptr(h)).clone();
-    const cv::Mat cr = cv::Mat(h / 2, w / 2, CV_8UC1, i420.ptr(h) + (w / 2) * (h / 2)).clone();
-    if (nv12) {
-        cv::merge(std::vector<cv::Mat>{cb, cr}, yuv.u);
-    } else {
-        yuv.u = cb;
-        yuv.v = cr;
-    }
-    return yuv;
-}
-
 /// The planes of `yuv` as views into larger images (rows padded, as a GstVideoFrame's may be).
 defocus::YuvImage padded(const defocus::YuvImage& yuv)
 {
@@ -634,15 +622,8 @@ TEST(LibraryYuv, ConversionIsOpenCvsAndTheStandardsColours)
         const bool nv12 = layout == defocus::YuvImage::Layout::Nv12;
         const defocus::YuvImage yuv = opencvYuv(bgr, layout);
         // OpenCV's own way back, from its packed layout.
-        cv::Mat packed(bgr.rows * 3 / 2, bgr.cols, CV_8UC1), reference;
-        yuv.y.copyTo(packed.rowRange(0, bgr.rows));
-        if (nv12) {
-            cv::Mat(bgr.rows / 2, bgr.cols, CV_8UC1, yuv.u.data).copyTo(packed.rowRange(bgr.rows, packed.rows));
-            cv::cvtColor(packed, reference, cv::COLOR_YUV2BGR_NV12);
-        } else {
-            cv::cvtColor(bgr, packed, cv::COLOR_BGR2YUV_I420);
-            cv::cvtColor(packed, reference, cv::COLOR_YUV2BGR_I420);
-        }
+        cv::Mat reference;
+        cv::cvtColor(packedPlanes(yuv), reference, nv12 ? cv::COLOR_YUV2BGR_NV12 : cv::COLOR_YUV2BGR_I420);
         const cv::Mat ours = defocus::yuvToBgr(yuv);
         ASSERT_EQ(ours.type(), CV_8UC3);
         EXPECT_LE(cv::norm(ours, reference, cv::NORM_INF), 1.0) << (nv12 ? "NV12" : "I420");
@@ -732,12 +713,7 @@ TEST(LibraryYuv, YuvInIsTheResultOfItsBgrOnEveryPreset)
                                   defocus::Quality::Preset::High})
             for (const auto kernel : {defocus::Quality::Hexagon::Rhombi, defocus::Quality::Hexagon::McIntosh})
                 for (const bool alwaysOn : {false, true}) {
-                    defocus::Settings settings;
-                    settings.depthScale = 5000;
-                    settings.lens.focusM = 1.0;
-                    settings.lens.fNumber = 1.4;
-                    settings.quality.preset = preset;
-                    settings.quality.hexagon = kernel;
+                    defocus::Settings settings = presetSettings(preset, kernel);
                     settings.quality.alwaysOn = alwaysOn;
                     const std::string what = fmt::format(
                         "{}, {}, {}, plan {}", layout == defocus::YuvImage::Layout::Nv12 ? "NV12" : "I420",

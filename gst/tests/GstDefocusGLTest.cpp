@@ -29,6 +29,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "tests/ImageCompare.hpp"
+#include "tests/YuvPlanes.hpp"
 
 namespace {
 
@@ -260,25 +261,11 @@ TEST_F(GstDefocus, I420AndNv12GoToTheFilterAsTheyCame)
     for (const Case& c : {Case{"I420", "bt709", M::Bt709, R::Limited}, Case{"NV12", "bt601", M::Bt601, R::Limited},
                           Case{"I420", "1:4:0:0", M::Bt601, R::Full}}) {
         const cv::Size size = frame_.bgr.size();
-        cv::Mat i420;
-        cv::cvtColor(frame_.bgr, i420, cv::COLOR_BGR2YUV_I420); // Y, Cb, Cr packed: GStreamer's I420 here
-        defocus::YuvImage yuv;
-        yuv.matrix = c.matrix;
+        defocus::YuvImage yuv = defocus::test::opencvYuv(
+            frame_.bgr, std::string(c.format) == "NV12" ? defocus::YuvImage::Layout::Nv12 : defocus::YuvImage::Layout::I420);
+        yuv.matrix = c.matrix; // the caps' colorimetry: how the element reads the same bytes
         yuv.range = c.range;
-        yuv.y = i420.rowRange(0, size.height);
-        const cv::Mat cb(size.height / 2, size.width / 2, CV_8UC1, i420.ptr(size.height));
-        const cv::Mat cr(size.height / 2, size.width / 2, CV_8UC1, i420.ptr(size.height) + cb.total());
-        cv::Mat packed = i420;
-        if (std::string(c.format) == "NV12") {
-            yuv.layout = defocus::YuvImage::Layout::Nv12;
-            cv::merge(std::vector<cv::Mat>{cb, cr}, yuv.u);
-            packed = cv::Mat(size.height * 3 / 2, size.width, CV_8UC1);
-            yuv.y.copyTo(packed.rowRange(0, size.height));
-            cv::Mat(size.height / 2, size.width, CV_8UC1, yuv.u.data).copyTo(packed.rowRange(size.height, packed.rows));
-        } else {
-            yuv.u = cb;
-            yuv.v = cr;
-        }
+        const cv::Mat packed = defocus::test::packedPlanes(yuv); // GStreamer's I420 and NV12 at this width
         Element e(kLens);
         gst_harness_set_src_caps_str(e.color, (caps(c.format, size) + ",colorimetry=" + c.colorimetry).c_str());
         gst_harness_set_src_caps_str(e.depth, caps("GRAY16_LE", frame_.depth16.size()).c_str());
