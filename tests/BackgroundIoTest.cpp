@@ -69,6 +69,18 @@ TEST(ReadAheadSource, GivesEveryFrameOnceInOrderThenTheEnd)
     EXPECT_FALSE(source.next());
 }
 
+/// Frames 0 to `frames` - 1 in order from `source`, then its SourceError, then nothing.
+void expectFramesThenTheError(ReadAheadSource& source, std::size_t frames)
+{
+    for (std::size_t i = 0; i < frames; ++i) {
+        const std::optional<Frame> frame = source.next();
+        ASSERT_TRUE(frame) << i;
+        EXPECT_EQ(frame->index, i);
+    }
+    EXPECT_THROW(source.next(), SourceError);
+    EXPECT_FALSE(source.next());
+}
+
 // The frames before a bad one are still given (nothing read is lost), then the source's own
 // error, of its own type: the programs' exit status depends on it (DeviceBusy: 75).
 TEST(ReadAheadSource, RethrowsTheSourcesErrorAfterTheFramesBeforeIt)
@@ -76,13 +88,7 @@ TEST(ReadAheadSource, RethrowsTheSourcesErrorAfterTheFramesBeforeIt)
     // Read ahead as far as the error before a frame is taken.
     ReadAheadSource source(std::make_unique<CountingSource>(10, 3), 4);
     std::this_thread::sleep_for(150ms);
-    for (std::size_t i = 0; i < 3; ++i) {
-        const std::optional<Frame> frame = source.next();
-        ASSERT_TRUE(frame) << i;
-        EXPECT_EQ(frame->index, i);
-    }
-    EXPECT_THROW(source.next(), SourceError);
-    EXPECT_FALSE(source.next());
+    expectFramesThenTheError(source, 3);
 
     ReadAheadSource busy(std::make_unique<CountingSource>(10, 0, true));
     EXPECT_THROW(busy.next(), DeviceBusy);
@@ -176,13 +182,7 @@ TEST(ReadAheadSource, ReadsSideBySideGiveTheFramesInStreamOrder)
 TEST(ReadAheadSource, AFailedReadComesAfterTheFramesBeforeItAndNothingAfter)
 {
     ReadAheadSource source(std::make_unique<SlowReadsSource>(40, 9), 6, 3);
-    for (std::size_t i = 0; i < 9; ++i) {
-        const std::optional<Frame> frame = source.next();
-        ASSERT_TRUE(frame) << i;
-        EXPECT_EQ(frame->index, i);
-    }
-    EXPECT_THROW(source.next(), SourceError);
-    EXPECT_FALSE(source.next());
+    expectFramesThenTheError(source, 9);
 
     // Stopped with reads under way: the destructor waits for them and returns.
     ReadAheadSource stopped(std::make_unique<SlowReadsSource>(1000), 8, 4);
