@@ -31,11 +31,30 @@
 // largest foreground blur that can reach this pixel (tile maxima dilated on the CPU); a nearer
 // tap that is blurrier than the centre counts where its own radius reaches the centre, with the
 // coverage a scattered segment of its length would give, and lies over the centre's own blur by
-// that coverage. FIRST_PASS and NEAR_FIELD are compile-time
+// that coverage.
+//
+// What a blurred object hides: a farther, sharper tap whose own blur does not reach the centre
+// lies behind the centre's blur, in the share of its piece the tap does not reach (as for nearer
+// taps). A real lens sees around the object there, and what it sees is hidden in the frame; the
+// visible background nearest the object is the best guess of it (a railing's bars over a lit
+// wall: the wall's lines run on behind the bars), not the mean of everything the centre's blur
+// spans (the wall blurred by the bars' blur, a notch in every line). So the hidden share of a
+// line takes the colour of its hidden taps weighted by BEHIND_FADE^(n-1), n counting them from
+// the object outwards. Pass 2's taps are pass-1 means that already hold the foreground's spread
+// and the object's antialiased edge near it, so its fade is gentler (docs/accuracy.md, "What
+// lies behind a blurred object").
+//
+// FIRST_PASS and NEAR_FIELD are compile-time
 // variants: llvmpipe pays for every instruction of a branch on a uniform. FUSED (second pass
 // only) writes the composite (A + 2B) / 3 itself, to one target: the output.
 #include "common.glsl"
 #include "rhombus_lines.glsl"
+
+#ifdef FIRST_PASS
+const float BEHIND_FADE = 0.5;
+#else
+const float BEHIND_FADE = 0.7;
+#endif
 
 layout(location = 0) out vec4 outFirst;
 #ifndef FUSED
@@ -102,6 +121,8 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
     vec3 foreground = vec3(0.0), foreground2 = vec3(0.0);
     float coverage = 0.0;
 #endif
+    vec3 behind = vec3(0.0), behind2 = vec3(0.0); // the hidden share's colour, faded outwards
+    float behindWeight = 0.0, behindNorm = 0.0, fade = 1.0;
     // UNROLLED: MAX_TAPS is a compile-time constant, so the compiler unrolls the loop, and
     // llvmpipe then runs every tap for every pixel (masked); the plain loop runs only as many as
     // the longest line among the pixels it shades together, with a loop's overhead per tap. The
@@ -152,9 +173,23 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
         coverage += share;
         weight *= 1.0 - reach;
 #endif
+        const float hidden = nearer ? 0.0 : clamp(1.0 - tapPiece / max(ownPiece, 1e-6), 0.0, 1.0);
+        const float hiddenWeight = weight * hidden;
+        weight -= hiddenWeight;
+        behindWeight += hiddenWeight;
+        behind += tap.rgb * (hiddenWeight * fade);
+        behind2 += tap2 * (hiddenWeight * fade);
+        behindNorm += hiddenWeight * fade;
+        fade *= mix(1.0, BEHIND_FADE, hidden);
         background += tap.rgb * weight;
         background2 += tap2 * weight;
         backgroundWeight += weight;
+    }
+    if (behindNorm > 0.0) {
+        // The mean first: a flat colour stays exactly itself.
+        background += (behind / behindNorm) * behindWeight;
+        background2 += (behind2 / behindNorm) * behindWeight;
+        backgroundWeight += behindWeight;
     }
     // The bleeding rule may reject every tap: the centre stays (its weight is > 0 whenever the
     // centre has a blur of its own; without one, the background is the centre).
