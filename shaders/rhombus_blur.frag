@@ -41,8 +41,9 @@
 // spans (the wall blurred by the bars' blur, a notch in every line). So the hidden share of a
 // line takes the colour of its hidden taps weighted by BEHIND_FADE^(n-1), n counting them from
 // the object outwards. Pass 2's taps are pass-1 means that already hold the foreground's spread
-// and the object's antialiased edge near it, so its fade is gentler (docs/accuracy.md, "What
-// lies behind a blurred object").
+// and the object's antialiased edge near it, so its fade is gentler: the corpus measured 0.7
+// there free of any loss, 0.5 and less losing up to 0.36 dB where a large object's edge meets a
+// brighter background (docs/accuracy.md, "What each improvement bought").
 //
 // FIRST_PASS and NEAR_FIELD are compile-time
 // variants: llvmpipe pays for every instruction of a branch on a uniform. FUSED (second pass

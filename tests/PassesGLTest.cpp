@@ -169,7 +169,7 @@ TEST_F(Passes, NearAndFarBlurMeetingDoNotCancel)
 // veil, dimmed by the bar's coverage only (Cycles' railing-lights truth shows its mortar lines
 // so). Defect caught: the gather fills the share of the bar's blur that the bar does not cover
 // with the mean of the wall its blur spans (the line blurred by the bar's blur), a notch in the
-// line as wide as the bar; docs/accuracy.md, "What lies behind a blurred object".
+// line as wide as the bar (docs/accuracy.md, "What each improvement bought").
 TEST_F(Passes, ALineBehindABlurredBarRunsOnBehindIt)
 {
     const cv::Size size(160, 120);
