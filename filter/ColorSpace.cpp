@@ -90,6 +90,18 @@ std::string yuvProblem(const YuvImage& image)
 {
     if (image.y.empty())
         return "Y'CbCr image: the luma plane (y) is empty";
+    if (image.layout == YuvImage::Layout::Yuyv) {
+        if (image.y.type() != CV_8UC2)
+            return fmt::format("Y'CbCr image: a YUYV image's y is {}; expected its packed pairs, 8-bit two-channel "
+                               "(CV_8UC2)",
+                               cv::typeToString(image.y.type()));
+        if (image.y.cols % 2 != 0)
+            return fmt::format("Y'CbCr image: a YUYV image is {} pixels wide; it has pairs of pixels, an even width",
+                               image.y.cols);
+        if (!image.u.empty() || !image.v.empty())
+            return "Y'CbCr image: u and v are for I420 and NV12; a YUYV image has Cb and Cr in y";
+        return {};
+    }
     if (image.y.type() != CV_8UC1)
         return fmt::format("Y'CbCr image: the luma plane (y) is {}; expected 8-bit (CV_8UC1)",
                            cv::typeToString(image.y.type()));
@@ -117,17 +129,20 @@ cv::Mat convertYuv(const YuvImage& image)
 {
     const YuvCoefficients c = yuvCoefficients(image.matrix, image.range);
     const bool nv12 = image.layout == YuvImage::Layout::Nv12;
+    const bool yuyv = image.layout == YuvImage::Layout::Yuyv;
     cv::Mat bgr(image.y.size(), CV_8UC3);
     const auto clamp8 = [](int v) { return static_cast<std::uint8_t>(std::clamp(v >> 8, 0, 255)); };
     cv::parallel_for_(cv::Range(0, bgr.rows), [&](const cv::Range& rows) {
         for (int y = rows.start; y < rows.end; ++y) {
+            // Each pixel's Y' at luma[x * lumaStep], its pair's (or block's) Cb and Cr at
+            // cb[(x / 2) * step] and cr[(x / 2) * step].
             const std::uint8_t* luma = image.y.ptr<std::uint8_t>(y);
-            const std::uint8_t* cb = image.u.ptr<std::uint8_t>(y / 2);
-            const std::uint8_t* cr = nv12 ? cb + 1 : image.v.ptr<std::uint8_t>(y / 2);
-            const int step = nv12 ? 2 : 1;
+            const std::uint8_t* cb = yuyv ? luma + 1 : image.u.ptr<std::uint8_t>(y / 2);
+            const std::uint8_t* cr = yuyv ? luma + 3 : nv12 ? cb + 1 : image.v.ptr<std::uint8_t>(y / 2);
+            const int lumaStep = yuyv ? 2 : 1, step = yuyv ? 4 : nv12 ? 2 : 1;
             auto* out = bgr.ptr<std::uint8_t>(y);
             for (int x = 0; x < bgr.cols; ++x) {
-                const int l = c.yScale * (luma[x] - c.yOffset) + 128;
+                const int l = c.yScale * (luma[x * lumaStep] - c.yOffset) + 128;
                 const int u = cb[(x / 2) * step] - 128, v = cr[(x / 2) * step] - 128;
                 out[3 * x + 0] = clamp8(l + c.cbToB * u);
                 out[3 * x + 1] = clamp8(l - c.cbToG * u - c.crToG * v);

@@ -36,7 +36,8 @@ struct YuvCoefficients {
 YuvCoefficients yuvCoefficients(YuvImage::Matrix matrix, YuvImage::Range range);
 /// What is wrong with `image`'s planes (types, sizes), in one line naming the plane; "" if nothing.
 std::string yuvProblem(const YuvImage& image);
-/// `image` as CV_8UC3 BGR: each pixel from its Y' and the Cb and Cr of its 2x2 block (nearest).
+/// `image` as CV_8UC3 BGR: each pixel from its Y' and the Cb and Cr of its 2x2 block (4:2:0) or
+/// of its pair (YUYV), nearest.
 /// Its planes must have passed yuvProblem().
 cv::Mat convertYuv(const YuvImage& image);
 

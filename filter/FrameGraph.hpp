@@ -61,7 +61,7 @@ enum class ImageFormat : std::uint8_t {
     Work,   ///< the blur targets' RGBA (rgb linear, a the signed CoC): RGBA16F or RGBA32F, by the
             ///< frame's TargetFormat; the pipeline's pool holds these
     Color,  ///< the frame as it went up: sRGB8 (decoded to linear on fetch) or RGB32F
-    Planes, ///< Y'CbCr 4:2:0 as it came: R8UI and RG8UI (NV12) or R8UI (I420) planes
+    Planes, ///< Y'CbCr as it came: R8UI and RG8UI (NV12), R8UI (I420) or RG8UI (YUYV) planes
     Given,  ///< the depth as it came: R16UI in its units, or R32F metres
     Metres, ///< R32F metres
     Measurement, ///< SceneMeasurePass's storage buffer

@@ -225,7 +225,7 @@ struct FrameContext {
     gl::Texture colorTexture;
     gl::Texture colorBytes;   ///< 8-bit frames: colorTexture's bytes, undecoded (SceneMeasurePass)
     gl::Framebuffer colorBytesTarget; ///< colorBytes', for YuvToRgbPass
-    gl::Texture yuvPlanes[3]; ///< Y'CbCr frames' planes as they came: Y', Cb (NV12: Cb and Cr), Cr
+    gl::Texture yuvPlanes[3]; ///< Y'CbCr frames' planes as they came: Y', Cb (NV12: Cb and Cr), Cr; YUYV's pairs
     gl::Texture depthAsGiven; ///< the frame's depth as it came (prepareOnGpu)
     gl::Texture depth;        ///< filled, the frame's size
     gl::Framebuffer depthTarget; ///< `depth`'s (DepthPrepPass writes it)
@@ -384,8 +384,8 @@ struct Pipeline::Impl {
                f.color);
             return;
         }
-        const bool nv12 = f.yuv.layout == YuvImage::Layout::Nv12;
-        const cv::Mat* planes[3] = {&f.yuv.y, &f.yuv.u, nv12 ? nullptr : &f.yuv.v};
+        const bool i420 = f.yuv.layout == YuvImage::Layout::I420, yuyv = f.yuv.layout == YuvImage::Layout::Yuyv;
+        const cv::Mat* planes[3] = {&f.yuv.y, yuyv ? nullptr : &f.yuv.u, i420 ? &f.yuv.v : nullptr};
         static const char* const kNames[3] = {"Y' plane", "Cb plane", "Cr plane"};
         for (int i = 0; i < 3; ++i) {
             if (!planes[i])
@@ -607,9 +607,7 @@ void Pipeline::Impl::prepare(FrameContext& f)
             timer.begin(node.name, f.serial);
             switch (node.pass) {
             case PassKind::YuvToRgb:
-                yuvToRgbPass.run(f.yuvPlanes[0], f.yuvPlanes[1],
-                                 f.yuv.layout == YuvImage::Layout::Nv12 ? nullptr : &f.yuvPlanes[2], f.yuv.matrix,
-                                 f.yuv.range, f.colorBytesTarget);
+                yuvToRgbPass.run(f.yuv.layout, f.yuvPlanes, f.yuv.matrix, f.yuv.range, f.colorBytesTarget);
                 break;
             case PassKind::DepthPrep:
                 depthPrepPass.run(f.hasDepth ? &f.depthAsGiven : nullptr, f.depthUnits, f.fallbackDepth,

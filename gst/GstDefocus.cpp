@@ -39,8 +39,8 @@ GST_DEBUG_CATEGORY_STATIC(gst_defocus_debug);
 namespace {
 
 /// A colour frame submitted to the filter and not yet received: the element's own mappings of
-/// its colour (as the colour pad prepared it, or I420 or NV12 as it came) and of its depth, which
-/// the filter reads until the frame is received, and what its output buffer takes.
+/// its colour (as the colour pad prepared it, or I420, NV12 or YUY2 as it came) and of its depth,
+/// which the filter reads until the frame is received, and what its output buffer takes.
 struct InFlight {
     GstVideoFrame color{}, depth{};
     GstClockTime pts = GST_CLOCK_TIME_NONE, duration = GST_CLOCK_TIME_NONE;
@@ -790,14 +790,20 @@ cv::Mat wrap(GstVideoFrame* frame, int type)
                    GST_VIDEO_FRAME_PLANE_DATA(frame, 0), static_cast<size_t>(GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0)));
 }
 
-/// The Y'CbCr matrix and range of `info` where the filter takes its frames as they are (I420 or
-/// NV12 in BT.601 or BT.709); nullopt for every other format, which the colour pad converts.
+/// The Y'CbCr matrix and range of `info` where the filter takes its frames as they are (I420,
+/// NV12, or YUY2 of an even width, in BT.601 or BT.709); nullopt for every other format, which
+/// the colour pad converts.
 std::optional<defocus::YuvImage> yuvLayout(const GstVideoInfo& info)
 {
     defocus::YuvImage yuv;
     switch (GST_VIDEO_INFO_FORMAT(&info)) {
     case GST_VIDEO_FORMAT_I420: yuv.layout = defocus::YuvImage::Layout::I420; break;
     case GST_VIDEO_FORMAT_NV12: yuv.layout = defocus::YuvImage::Layout::Nv12; break;
+    case GST_VIDEO_FORMAT_YUY2:
+        if (GST_VIDEO_INFO_WIDTH(&info) % 2 != 0)
+            return std::nullopt; // the last pixel's Cr lies in the row's padding
+        yuv.layout = defocus::YuvImage::Layout::Yuyv;
+        break;
     default: return std::nullopt;
     }
     switch (info.colorimetry.matrix) {
@@ -810,7 +816,8 @@ std::optional<defocus::YuvImage> yuvLayout(const GstVideoInfo& info)
     return yuv;
 }
 
-/// `frame` (I420 or NV12, yuvLayout() of its info) as the filter's YuvImage: its planes, no copy.
+/// `frame` (I420, NV12 or YUY2, yuvLayout() of its info) as the filter's YuvImage: its planes, no
+/// copy.
 defocus::YuvImage toYuv(GstVideoFrame* frame)
 {
     defocus::YuvImage yuv = *yuvLayout(frame->info);
@@ -820,6 +827,10 @@ defocus::YuvImage toYuv(GstVideoFrame* frame)
         return cv::Mat(size, type, GST_VIDEO_FRAME_PLANE_DATA(frame, i),
                        static_cast<size_t>(GST_VIDEO_FRAME_PLANE_STRIDE(frame, i)));
     };
+    if (yuv.layout == defocus::YuvImage::Layout::Yuyv) {
+        yuv.y = plane(0, {width, height}, CV_8UC2);
+        return yuv;
+    }
     yuv.y = plane(0, {width, height}, CV_8UC1);
     if (yuv.layout == defocus::YuvImage::Layout::Nv12) {
         yuv.u = plane(1, half, CV_8UC2);
@@ -1017,7 +1028,7 @@ GstFlowReturn guarded(GstDefocus* self, InFlight& frame, Call&& call)
     return GST_FLOW_ERROR;
 }
 
-/// Submits `color` (the output's format, or I420 or NV12 as it came) with `depth` to the filter,
+/// Submits `color` (the output's format, or I420, NV12 or YUY2 as it came) with `depth` to the filter,
 /// to come out with `pts` and `duration`; the frame joins the frames in flight.
 GstFlowReturn submit(GstDefocus* self, GstVideoFrame* color, GstBuffer* depth, GstVideoInfo* depthInfo,
                      GstClockTime pts, GstClockTime duration)
@@ -1386,8 +1397,8 @@ GstFlowReturn aggregate(GstAggregator* agg, gboolean timeout)
             ret = renderGl(self, outbuf, colorBuffer, &colorInfo, s.depthFrame, &depthInfo);
         }
     } else {
-        // The colour in the output's format (the colour pad converts it), or I420 and NV12 as
-        // they came (the filter converts them, on the GPU where it has one), the depth as it
+        // The colour in the output's format (the colour pad converts it), or I420, NV12 and YUY2
+        // as they came (the filter converts them, on the GPU where it has one), the depth as it
         // came, submitted; the oldest frame in flight comes out when the filter holds its
         // kFramesInFlight, and every one when no colour frame waits behind this one (a frame is
         // never held for input that is not there: no latency added).

@@ -65,6 +65,8 @@ defocus::Settings presetSettings(defocus::Quality::Preset preset, defocus::Quali
     settings.quality.hexagon = kernel;
     return settings;
 }
+using defocus::test::layoutName;
+using defocus::test::opencvToBgr;
 using defocus::test::opencvYuv;
 using defocus::test::packedPlanes;
 
@@ -618,15 +620,15 @@ TEST(LibraryYuv, ConversionIsOpenCvsAndTheStandardsColours)
 {
     const Pair pair = bundled(9);
     const cv::Mat bgr = cv::imread(pair.color.string(), cv::IMREAD_COLOR);
-    for (const auto layout : {defocus::YuvImage::Layout::I420, defocus::YuvImage::Layout::Nv12}) {
-        const bool nv12 = layout == defocus::YuvImage::Layout::Nv12;
+    for (const auto layout :
+         {defocus::YuvImage::Layout::I420, defocus::YuvImage::Layout::Nv12, defocus::YuvImage::Layout::Yuyv}) {
         const defocus::YuvImage yuv = opencvYuv(bgr, layout);
         // OpenCV's own way back, from its packed layout.
         cv::Mat reference;
-        cv::cvtColor(packedPlanes(yuv), reference, nv12 ? cv::COLOR_YUV2BGR_NV12 : cv::COLOR_YUV2BGR_I420);
+        cv::cvtColor(packedPlanes(yuv), reference, opencvToBgr(layout));
         const cv::Mat ours = defocus::yuvToBgr(yuv);
         ASSERT_EQ(ours.type(), CV_8UC3);
-        EXPECT_LE(cv::norm(ours, reference, cv::NORM_INF), 1.0) << (nv12 ? "NV12" : "I420");
+        EXPECT_LE(cv::norm(ours, reference, cv::NORM_INF), 1.0) << layoutName(layout);
         EXPECT_TRUE(identical(defocus::yuvToBgr(padded(yuv)), ours)) << "planes with padded rows";
     }
     // Full range (JPEG): OpenCV's YCrCb on 4:4:4 planes, each block's chroma repeated.
@@ -662,7 +664,8 @@ TEST(LibraryYuv, ConversionIsOpenCvsAndTheStandardsColours)
 }
 
 // Defects caught: planes of the wrong type or size taken (read past a plane's end), an NV12
-// image's stray Cr plane or an I420's missing one passing; each refused in one line naming it.
+// image's stray Cr plane or an I420's missing one passing, a YUYV image of an odd width (its last
+// pixel's Cr beyond the row) or of single-channel bytes; each refused in one line naming it.
 TEST(LibraryYuv, PlanesOfTheWrongShapeAreInputErrorsNamingThem)
 {
     const cv::Mat bgr(48, 64, CV_8UC3, cv::Scalar(40, 80, 120));
@@ -691,6 +694,17 @@ TEST(LibraryYuv, PlanesOfTheWrongShapeAreInputErrorsNamingThem)
     wrong.v = cv::Mat();
     wrong.layout = defocus::YuvImage::Layout::I420;
     EXPECT_NE(message(wrong).find("Cb plane (u) is CV_8UC2"), std::string::npos) << message(wrong);
+    const defocus::YuvImage pairs = opencvYuv(bgr, defocus::YuvImage::Layout::Yuyv);
+    wrong = pairs;
+    wrong.y = pairs.y.colRange(0, 63);
+    EXPECT_NE(message(wrong).find("a YUYV image is 63 pixels wide"), std::string::npos) << message(wrong);
+    wrong = pairs;
+    wrong.y = good.y;
+    EXPECT_NE(message(wrong).find("a YUYV image's y is CV_8UC1"), std::string::npos) << message(wrong);
+    wrong = pairs;
+    wrong.u = good.u;
+    EXPECT_NE(message(wrong).find("a YUYV image has Cb and Cr in y"), std::string::npos) << message(wrong);
+    EXPECT_EQ(message(pairs), "accepted");
 }
 
 // Defects caught: Y'CbCr in that is not its BGR's result, on either path (the GPU's planes and
@@ -705,7 +719,8 @@ TEST(LibraryYuv, YuvInIsTheResultOfItsBgrOnEveryPreset)
     cv::resize(bgr, bgr, {320, 240}, 0, 0, cv::INTER_AREA);
     cv::resize(cv::imread(pair.depth.string(), cv::IMREAD_UNCHANGED), depth, {320, 240}, 0, 0, cv::INTER_NEAREST);
     const cv::Mat flat(depth.size(), CV_16UC1, cv::Scalar(5000)); // all at the focus, 1 m
-    for (const auto layout : {defocus::YuvImage::Layout::I420, defocus::YuvImage::Layout::Nv12}) {
+    for (const auto layout :
+         {defocus::YuvImage::Layout::I420, defocus::YuvImage::Layout::Nv12, defocus::YuvImage::Layout::Yuyv}) {
         defocus::YuvImage yuv = padded(opencvYuv(bgr, layout));
         yuv.matrix = defocus::YuvImage::Matrix::Bt709; // any: the same conversion either way
         const cv::Mat converted = defocus::yuvToBgr(yuv);
@@ -716,7 +731,7 @@ TEST(LibraryYuv, YuvInIsTheResultOfItsBgrOnEveryPreset)
                     defocus::Settings settings = presetSettings(preset, kernel);
                     settings.quality.alwaysOn = alwaysOn;
                     const std::string what = fmt::format(
-                        "{}, {}, {}, plan {}", layout == defocus::YuvImage::Layout::Nv12 ? "NV12" : "I420",
+                        "{}, {}, {}, plan {}", layoutName(layout),
                         defocus::qualityName(preset), kernel == defocus::Quality::Hexagon::Rhombi ? "rhombi" : "mcintosh",
                         alwaysOn ? "off" : "on");
                     std::optional<defocus::Filter> filter;

@@ -15,21 +15,23 @@ constexpr GLint kMoreLocation = 1;
 YuvToRgbPass::YuvToRgbPass()
     : i420_("fullscreen.vert", "yuv_to_rgb.frag", "yuv-to-rgb I420"),
       nv12_("fullscreen.vert", "yuv_to_rgb.frag", "yuv-to-rgb NV12", {"NV12 1"}),
+      yuyv_("fullscreen.vert", "yuv_to_rgb.frag", "yuv-to-rgb YUYV", {"YUYV 1"}),
       nearest_(GL_NEAREST, "yuv-to-rgb nearest")
 {
 }
 
-void YuvToRgbPass::run(const gl::Texture& luma, const gl::Texture& cb, const gl::Texture* cr, YuvImage::Matrix matrix,
+void YuvToRgbPass::run(YuvImage::Layout layout, const gl::Texture (&planes)[3], YuvImage::Matrix matrix,
                        YuvImage::Range range, const gl::Framebuffer& target)
 {
-    const gl::Program& program = cr ? i420_ : nv12_;
+    const int count = layout == YuvImage::Layout::I420 ? 3 : layout == YuvImage::Layout::Nv12 ? 2 : 1;
+    const gl::Program& program = layout == YuvImage::Layout::I420   ? i420_
+                                 : layout == YuvImage::Layout::Nv12 ? nv12_
+                                                                    : yuyv_;
     const YuvCoefficients c = yuvCoefficients(matrix, range);
     glProgramUniform4i(program.id(), kCoefficientsLocation, c.yOffset, c.yScale, c.crToR, c.cbToG);
     glProgramUniform2i(program.id(), kMoreLocation, c.crToG, c.cbToB);
-    bindTexture(0, luma.id(), nearest_.id());
-    bindTexture(1, cb.id(), nearest_.id());
-    if (cr)
-        bindTexture(2, cr->id(), nearest_.id());
+    for (int i = 0; i < count; ++i)
+        bindTexture(static_cast<GLuint>(i), planes[i].id(), nearest_.id());
     target.bindForDraw();
     program.use();
     drawFullscreenTriangle();

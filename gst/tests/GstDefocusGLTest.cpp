@@ -244,11 +244,11 @@ TEST_F(GstDefocus, RgbxColourAndBigEndianDepthMatchTheLibrary)
     EXPECT_TRUE(identical(out, expected));
 }
 
-// Defects caught: I420 or NV12 converted by the colour pad on the CPU (GStreamer's converter
+// Defects caught: I420, NV12 or YUY2 converted by the colour pad on the CPU (GStreamer's converter
 // rounds and resamples the chroma otherwise) instead of given to the filter as it came, the
-// caps' matrix or range not passed on, an NV12 plane read as I420's. The filter's result of its
-// yuvToBgr() is the reference, byte for byte.
-TEST_F(GstDefocus, I420AndNv12GoToTheFilterAsTheyCame)
+// caps' matrix or range not passed on, an NV12 plane read as I420's, YUY2's pairs read as planes.
+// The filter's result of its yuvToBgr() is the reference, byte for byte.
+TEST_F(GstDefocus, I420Nv12AndYuy2GoToTheFilterAsTheyCame)
 {
     struct Case {
         const char* format;
@@ -258,14 +258,16 @@ TEST_F(GstDefocus, I420AndNv12GoToTheFilterAsTheyCame)
     };
     using M = defocus::YuvImage::Matrix;
     using R = defocus::YuvImage::Range;
+    using L = defocus::YuvImage::Layout;
     for (const Case& c : {Case{"I420", "bt709", M::Bt709, R::Limited}, Case{"NV12", "bt601", M::Bt601, R::Limited},
-                          Case{"I420", "1:4:0:0", M::Bt601, R::Full}}) {
+                          Case{"I420", "1:4:0:0", M::Bt601, R::Full}, Case{"YUY2", "bt601", M::Bt601, R::Limited}}) {
         const cv::Size size = frame_.bgr.size();
+        const std::string format = c.format;
         defocus::YuvImage yuv = defocus::test::opencvYuv(
-            frame_.bgr, std::string(c.format) == "NV12" ? defocus::YuvImage::Layout::Nv12 : defocus::YuvImage::Layout::I420);
+            frame_.bgr, format == "NV12" ? L::Nv12 : format == "YUY2" ? L::Yuyv : L::I420);
         yuv.matrix = c.matrix; // the caps' colorimetry: how the element reads the same bytes
         yuv.range = c.range;
-        const cv::Mat packed = defocus::test::packedPlanes(yuv); // GStreamer's I420 and NV12 at this width
+        const cv::Mat packed = defocus::test::packedPlanes(yuv); // GStreamer's buffers at this width
         Element e(kLens);
         gst_harness_set_src_caps_str(e.color, (caps(c.format, size) + ",colorimetry=" + c.colorimetry).c_str());
         gst_harness_set_src_caps_str(e.depth, caps("GRAY16_LE", frame_.depth16.size()).c_str());

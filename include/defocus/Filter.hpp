@@ -161,9 +161,10 @@ struct RendererInfo {
 /// (gst_gl_display_egl_new_with_egl_display). Throws GlError where no context can be made.
 DEFOCUS_API void* eglDisplay(const ContextOptions& context = {});
 /// `image` as the filter sees it: CV_8UC3 BGR, each pixel from its own Y' and the Cb and Cr of its
-/// 2x2 block (nearest, as OpenCV's cvtColor and video players' fast paths take them), in 8-bit
-/// fixed point with the coefficients of its matrix and range (BT.601 limited: within one level of
-/// cv::cvtColor's COLOR_YUV2BGR_I420). Throws InputError for planes of the wrong type or size.
+/// 2x2 block or YUYV pair (nearest, as OpenCV's cvtColor and video players' fast paths take
+/// them), in 8-bit fixed point with the coefficients of its matrix and range (BT.601 limited:
+/// within one level of cv::cvtColor's COLOR_YUV2BGR_I420). Throws InputError for planes of the
+/// wrong type or size.
 DEFOCUS_API cv::Mat yuvToBgr(const YuvImage& image);
 /// The EGL devices of this machine; empty where EGL cannot enumerate them.
 DEFOCUS_API std::vector<EglDevice> eglDevices();
@@ -211,10 +212,10 @@ public:
     /// between frames; 0 = unknown, taken as 1/30 s). Throws InputError for images it cannot
     /// take and SettingsError when an automatic focus comes out of range.
     cv::Mat process(const cv::Mat& color, const cv::Mat& depth, double timestampS = 0.0);
-    /// process() of colour as video decoders and cameras give it (YuvImage: I420 or NV12, its
-    /// planes views or not): the same bytes as process(yuvToBgr(color), depth, timestampS). On
-    /// a GPU the planes go up as they are (1.5 bytes a pixel instead of BGR's 3) and become
-    /// colour there; on a software renderer the CPU converts them. Throws InputError for planes
+    /// process() of colour as video decoders and cameras give it (YuvImage: I420, NV12 or YUYV,
+    /// its planes views or not): the same bytes as process(yuvToBgr(color), depth, timestampS).
+    /// On a GPU the planes go up as they are (1.5 bytes a pixel for 4:2:0, 2 for YUYV, instead
+    /// of BGR's 3) and become colour there; on a software renderer the CPU converts them. Throws InputError for planes
     /// of the wrong type or size.
     cv::Mat process(const YuvImage& color, const cv::Mat& depth, double timestampS = 0.0);
     /// process() for a frame in textures of the caller's context (ContextOptions::callerContext;

@@ -36,15 +36,20 @@ struct Frame {
 };
 
 /// A colour image as video decoders and cameras give it: 8-bit Y'CbCr 4:2:0, planar (I420: Y, then
-/// Cb, then Cr) or semi-planar (NV12: Y, then Cb and Cr interleaved), each plane a cv::Mat that may
-/// view the caller's buffer (a GstVideoFrame's planes, a V4L2 buffer; rows may have padding).
+/// Cb, then Cr) or semi-planar (NV12: Y, then Cb and Cr interleaved), or 4:2:2 packed as webcams
+/// send it (YUYV, GStreamer's YUY2: Y0 Cb Y1 Cr for each pair of pixels), each plane a cv::Mat
+/// that may view the caller's buffer (a GstVideoFrame's planes, a V4L2 buffer; rows may have
+/// padding).
 /// Filter::process() and submit() take it as they take BGR: on a GPU its planes go up as they are,
 /// half the bytes of BGR, and become colour there; where the CPU prepares depth (a software
 /// renderer) they become BGR on the CPU. Either way the filter sees yuvToBgr() of it.
 struct YuvImage {
     enum class Layout {
         I420, ///< u: Cb (CV_8UC1), v: Cr (CV_8UC1)
-        Nv12  ///< u: Cb and Cr interleaved (CV_8UC2), v: empty
+        Nv12, ///< u: Cb and Cr interleaved (CV_8UC2), v: empty
+        /// y: the packed pairs (CV_8UC2, the image's size, an even width): Y' in the first
+        /// channel, Cb (even columns) or Cr (odd columns) of the pair in the second; u, v: empty
+        Yuyv
     };
     /// The matrix from R'G'B' to Y'CbCr: BT.601 (standard-definition video, JPEG) or BT.709 (HD).
     enum class Matrix { Bt601, Bt709 };
@@ -54,7 +59,7 @@ struct YuvImage {
     Layout layout = Layout::I420;
     Matrix matrix = Matrix::Bt709;
     Range range = Range::Limited;
-    cv::Mat y; ///< CV_8UC1 luma, the image's size
+    cv::Mat y; ///< CV_8UC1 luma, the image's size (YUYV: see Layout)
     cv::Mat u; ///< chroma at half the width and height, rounded up (see Layout)
     cv::Mat v;
 };
