@@ -86,6 +86,11 @@ YuvCoefficients yuvCoefficients(YuvImage::Matrix matrix, YuvImage::Range range)
     return c;
 }
 
+int yuvPlaneCount(YuvImage::Layout layout)
+{
+    return layout == YuvImage::Layout::I420 ? 3 : layout == YuvImage::Layout::Nv12 ? 2 : 1;
+}
+
 std::string yuvProblem(const YuvImage& image)
 {
     if (image.y.empty())

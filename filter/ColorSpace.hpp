@@ -34,6 +34,8 @@ struct YuvCoefficients {
     int crToR = 409, cbToG = 100, crToG = 208, cbToB = 516;
 };
 YuvCoefficients yuvCoefficients(YuvImage::Matrix matrix, YuvImage::Range range);
+/// The planes of `layout`, in YuvImage's order y, u, v: I420 3, NV12 2, YUYV 1.
+int yuvPlaneCount(YuvImage::Layout layout);
 /// What is wrong with `image`'s planes (types, sizes), in one line naming the plane; "" if nothing.
 std::string yuvProblem(const YuvImage& image);
 /// `image` as CV_8UC3 BGR: each pixel from its Y' and the Cb and Cr of its 2x2 block (4:2:0) or

@@ -384,12 +384,9 @@ struct Pipeline::Impl {
                f.color);
             return;
         }
-        const bool i420 = f.yuv.layout == YuvImage::Layout::I420, yuyv = f.yuv.layout == YuvImage::Layout::Yuyv;
-        const cv::Mat* planes[3] = {&f.yuv.y, yuyv ? nullptr : &f.yuv.u, i420 ? &f.yuv.v : nullptr};
+        const cv::Mat* planes[3] = {&f.yuv.y, &f.yuv.u, &f.yuv.v};
         static const char* const kNames[3] = {"Y' plane", "Cb plane", "Cr plane"};
-        for (int i = 0; i < 3; ++i) {
-            if (!planes[i])
-                continue;
+        for (int i = 0; i < yuvPlaneCount(f.yuv.layout); ++i) {
             const bool pair = planes[i]->channels() == 2;
             ensureTexture(f.yuvPlanes[i], pair ? GL_RG8UI : GL_R8UI, planes[i]->size(), kNames[i]);
             // Planes go up whole rows at a time: a view with padded rows, copied here (the CPU's

@@ -23,14 +23,13 @@ YuvToRgbPass::YuvToRgbPass()
 void YuvToRgbPass::run(YuvImage::Layout layout, const gl::Texture (&planes)[3], YuvImage::Matrix matrix,
                        YuvImage::Range range, const gl::Framebuffer& target)
 {
-    const int count = layout == YuvImage::Layout::I420 ? 3 : layout == YuvImage::Layout::Nv12 ? 2 : 1;
     const gl::Program& program = layout == YuvImage::Layout::I420   ? i420_
                                  : layout == YuvImage::Layout::Nv12 ? nv12_
                                                                     : yuyv_;
     const YuvCoefficients c = yuvCoefficients(matrix, range);
     glProgramUniform4i(program.id(), kCoefficientsLocation, c.yOffset, c.yScale, c.crToR, c.cbToG);
     glProgramUniform2i(program.id(), kMoreLocation, c.crToG, c.cbToB);
-    for (int i = 0; i < count; ++i)
+    for (int i = 0; i < yuvPlaneCount(layout); ++i)
         bindTexture(static_cast<GLuint>(i), planes[i].id(), nearest_.id());
     target.bindForDraw();
     program.use();
