@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// sRGB decode/encode, with a 256-entry table for 8-bit decode; Y'CbCr 4:2:0 to BGR.
+// sRGB decode/encode, with a 256-entry table for 8-bit decode; 8-bit Y'CbCr (4:2:0, YUYV) to BGR.
 #include "filter/ColorSpace.hpp"
 
 #include <algorithm>

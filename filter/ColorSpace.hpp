@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The sRGB transfer functions on the CPU (the GPU uses sRGB textures and framebuffers), and 8-bit
-// Y'CbCr 4:2:0 to BGR in the integer arithmetic the GPU's yuv_to_rgb.frag does too.
+// Y'CbCr (4:2:0 planes, YUYV's packed pairs) to BGR in the integer arithmetic the GPU's
+// yuv_to_rgb.frag does too.
 #pragma once
 
 #include <string>

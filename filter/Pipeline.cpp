@@ -225,7 +225,8 @@ struct FrameContext {
     gl::Texture colorTexture;
     gl::Texture colorBytes;   ///< 8-bit frames: colorTexture's bytes, undecoded (SceneMeasurePass)
     gl::Framebuffer colorBytesTarget; ///< colorBytes', for YuvToRgbPass
-    gl::Texture yuvPlanes[3]; ///< Y'CbCr frames' planes as they came: Y', Cb (NV12: Cb and Cr), Cr; YUYV's pairs
+    /// Y'CbCr frames' planes as they came: Y', Cb (NV12: Cb and Cr), Cr; YUYV: its pairs alone.
+    gl::Texture yuvPlanes[3];
     gl::Texture depthAsGiven; ///< the frame's depth as it came (prepareOnGpu)
     gl::Texture depth;        ///< filled, the frame's size
     gl::Framebuffer depthTarget; ///< `depth`'s (DepthPrepPass writes it)

@@ -92,7 +92,7 @@ public:
     /// `depthUnitsPerMetre` 0: the frame's depth is CV_32FC1 metres; otherwise CV_16UC1 in those
     /// units (0: no measurement), uploaded as it is and converted on the GPU (converted on the
     /// CPU where depth prep runs there).
-    /// `yuv`: the frame's colour as Y'CbCr 4:2:0 planes (yuvProblem() found nothing wrong), with
+    /// `yuv`: the frame's colour as Y'CbCr planes (yuvProblem() found nothing wrong), with
     /// `frame.color` empty; uploaded as they came and converted on the GPU (YuvToRgbPass), or
     /// converted on the CPU (convertYuv()) where depth prep runs there.
     void process(const Frame& frame, const LensSettings& lens, const QualitySettings& quality,

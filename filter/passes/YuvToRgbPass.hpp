@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// Y'CbCr 4:2:0 planes or YUYV's packed pairs, uploaded as they came, to the frame's colour bytes: the bytes BGR input
-// would have uploaded (convertYuv() on the CPU gives the same). Shader: yuv_to_rgb.frag. Drawn:
-// the colour texture (RGB8) is no image format a compute shader can store to.
+// Y'CbCr 4:2:0 planes or YUYV's packed pairs, uploaded as they came, to the frame's colour bytes:
+// the bytes BGR input would have uploaded (convertYuv() on the CPU gives the same). Shader:
+// yuv_to_rgb.frag. Drawn: the colour texture (RGB8) is no image format a compute shader can
+// store to.
 #pragma once
 
 #include "defocus/Frame.hpp"
