@@ -143,6 +143,31 @@ std::size_t putLightEdgesAtTheirLightsDepth(const cv::Mat& colorLinear, cv::Mat&
     // changes (a light's edge pixels: few) are applied after the scan, which runs in bands of
     // rows on OpenCV's threads, each band with its own list.
     const int last = colorLinear.rows - 1, lastX = colorLinear.cols - 1;
+    // The depth of the light whose brightest pixel is `at`: that pixel's own, unless the pixel is
+    // the edge of a nearer surface with the light beyond it, a sliver of a light beside a bar
+    // whose depth sample fell on the bar. It is such an edge when, across it, a neighbour is
+    // brighter than white and farther while the opposite neighbour is not above white and lies on
+    // the near side (nearer than halfway): the nearer surface is dim, so the pixel's light came
+    // from beyond it. A light's own edge in front of a background has its light inside (the
+    // opposite neighbour bright), a light one pixel wide the background on both sides: neither
+    // moves. Of several such neighbours, the farthest, the first in row order on a tie.
+    const auto lightDepth = [&](cv::Point at) {
+        const float own = metres.at<float>(at);
+        float depth = own;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const cv::Point beyond{at.x + dx, at.y + dy}, opposite{at.x - dx, at.y - dy};
+                if ((dx == 0 && dy == 0) || std::min({beyond.x, beyond.y, opposite.x, opposite.y}) < 0 ||
+                    std::max(beyond.x, opposite.x) > lastX || std::max(beyond.y, opposite.y) > last)
+                    continue;
+                const float far = metres.at<float>(beyond);
+                if (far > depth && 2.0f * metres.at<float>(opposite) <= own + far &&
+                    luminance(colorLinear.at<cv::Vec3f>(beyond)) > 1.0f &&
+                    !(luminance(colorLinear.at<cv::Vec3f>(opposite)) > 1.0f))
+                    depth = far;
+            }
+        return depth;
+    };
     std::vector<std::vector<std::pair<cv::Point, float>>> bands(static_cast<std::size_t>(colorLinear.rows));
     cv::parallel_for_(cv::Range(0, colorLinear.rows), [&](const cv::Range& range) {
         for (int y = range.start; y < range.end; ++y) {
@@ -160,7 +185,7 @@ std::size_t putLightEdgesAtTheirLightsDepth(const cv::Mat& colorLinear, cv::Mat&
                             brightest = b;
                             at = {qx, qy};
                         }
-                if (const float z = metres.at<float>(at); z != metres.at<float>(y, x))
+                if (const float z = lightDepth(at); z != metres.at<float>(y, x))
                     changes.emplace_back(cv::Point{x, y}, z);
             }
         }

@@ -59,7 +59,11 @@ void prepareDepth(const cv::Mat& depth, cv::Size size, float fallbackM, DepthPre
 /// hexagon as large as that blur around a light in front of a background, or beside the
 /// nearer bar of a railing in front of a light (docs/accuracy.md, "What each improvement
 /// bought"). The other surface's share of the pixel then takes the light's blur: one pixel's
-/// worth. Returns the pixels changed.
+/// worth. The brightest pixel's own depth can be the other surface's too, where only a sliver of
+/// a light shows beside a nearer bar: a brightest pixel with a farther neighbour above white
+/// across it from a dim one on the near side (nearer than halfway) is the nearer surface's edge
+/// with the light beyond it, and gives that neighbour's depth (the farthest such). Decided on the
+/// depth as it was. Returns the pixels changed.
 std::size_t putLightEdgesAtTheirLightsDepth(const cv::Mat& colorLinear, cv::Mat& metres);
 
 /// Depth of another size is resized to the colour, but only at the same aspect ratio: they agree

@@ -148,6 +148,33 @@ float luminance(vec3 rgb)
     return 0.0722 * rgb.b + 0.7152 * rgb.g + 0.2126 * rgb.r;
 }
 
+float luminanceAt(ivec2 texel)
+{
+    return luminance(texelFetch(uColor, texel, 0).rgb);
+}
+
+// The depth of the light whose brightest pixel is `at`: its own, unless it is the edge of a
+// nearer, dim surface with the light beyond it (a neighbour above white and farther, the opposite
+// one not above white and nearer than halfway); then the farthest such neighbour's, the first in
+// row order on a tie (the CPU's rule, filter/DepthPrep.cpp).
+float lightDepth(ivec2 at)
+{
+    const float own = texelFetch(uDepth, at, 0).r;
+    float depth = own;
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+            const ivec2 beyond = at + ivec2(dx, dy), opposite = at - ivec2(dx, dy);
+            if ((dx == 0 && dy == 0) || any(lessThan(min(beyond, opposite), ivec2(0))) ||
+                any(greaterThanEqual(max(beyond, opposite), uSize)))
+                continue;
+            const float far = texelFetch(uDepth, beyond, 0).r;
+            if (far > depth && 2.0 * texelFetch(uDepth, opposite, 0).r <= own + far && luminanceAt(beyond) > 1.0 &&
+                !(luminanceAt(opposite) > 1.0))
+                depth = far;
+        }
+    return depth;
+}
+
 void main()
 {
     const ivec2 p = ivec2(gl_FragCoord.xy);
@@ -165,7 +192,7 @@ void main()
                     at = ivec2(x, y);
                 }
             }
-        z = texelFetch(uDepth, at, 0).r;
+        z = lightDepth(at);
     }
     outDepth = z;
 }

@@ -144,7 +144,8 @@ TEST_F(DepthPrepGpu, GpuPutsAFrameWithoutMeasurementsAtTheFocusDistance)
 }
 
 // Defects caught: the lights' edges not moved to their lights' depth on the GPU (or moved
-// further: a pixel to a farther light, a light's neighbour that is not above white), so that
+// further: a pixel to a farther light, a light's neighbour that is not above white; a light's
+// sliver beside a bar left at the bar's depth: this frame has such slivers), so that
 // the sprites' light and the gather's disagree with the CPU's.
 TEST_F(DepthPrepGpu, GpuPutsLightEdgesAtTheirLightsDepthAsTheCpuDoes)
 {

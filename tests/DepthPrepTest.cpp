@@ -193,5 +193,40 @@ TEST(DepthPrep, LightEdgesTakeTheLightsDepthDecidedOnTheDepthAsItWas)
     EXPECT_EQ(cv::norm(metres, expected, cv::NORM_INF), 0.0);
 }
 
+TEST(DepthPrep, ASliverOfALightBesideANearBarTakesTheLightsDepth)
+{
+    // Catches a light's sliver beside a bar kept at the bar's depth when its brightest pixel's
+    // depth sample fell on the bar: the sliver then took the bar's blur, a pale hexagon as wide as
+    // that blur where the lens shows a sharp dot (the railing-lights scene of the corpus). Also
+    // catches the rule reaching too far: a light's own edge in front of a background (its inside
+    // bright) or a light one pixel wide (the background on both sides) sent to the background.
+    // A 64 x 48 frame of 0.1 at 10 m with a bar at 1 m in columns 5-12; in rows 20-22 the bar's
+    // last column is a light's edge of 60, the column beyond it the light's 50. In row 30 a light
+    // at 1 m in columns 38-40 (55, 55, 60) before a pixel of 50 at 10 m; in row 36 one pixel of
+    // 60 at 1 m between pixels of 50 at 10 m.
+    cv::Mat color(48, 64, CV_32FC3, cv::Scalar::all(0.1));
+    cv::Mat depth(color.size(), CV_32F, cv::Scalar(10.0f));
+    depth(cv::Rect(5, 0, 8, 48)).setTo(1.0f);
+    color(cv::Rect(12, 20, 1, 3)).setTo(cv::Scalar::all(60.0));
+    color(cv::Rect(13, 20, 1, 3)).setTo(cv::Scalar::all(50.0));
+    color(cv::Rect(38, 30, 2, 1)).setTo(cv::Scalar::all(55.0));
+    color.at<cv::Vec3f>(30, 40) = cv::Vec3f::all(60.0f);
+    color.at<cv::Vec3f>(30, 41) = cv::Vec3f::all(50.0f);
+    depth(cv::Rect(38, 30, 3, 1)).setTo(1.0f);
+    color(cv::Rect(20, 36, 3, 1)).setTo(cv::Scalar::all(50.0));
+    color.at<cv::Vec3f>(36, 21) = cv::Vec3f::all(60.0f);
+    depth.at<float>(36, 21) = 1.0f;
+    cv::Mat expected = depth.clone();
+    expected(cv::Rect(12, 20, 1, 3)).setTo(10.0f); // the light's edge sampled on the bar
+    expected.at<float>(30, 41) = 1.0f;              // the near light's antialiased edge
+    expected.at<float>(36, 20) = 1.0f;              // the one-pixel light's edges
+    expected.at<float>(36, 22) = 1.0f;
+    cv::Mat metres = depth.clone();
+    EXPECT_EQ(putLightEdgesAtTheirLightsDepth(color, metres), 6u);
+    EXPECT_EQ(cv::norm(metres, expected, cv::NORM_INF), 0.0)
+        << "bar edge " << metres(cv::Rect(11, 19, 4, 5)) << "\nnear light " << metres(cv::Rect(37, 29, 6, 3))
+        << "\none pixel " << metres(cv::Rect(19, 35, 5, 3));
+}
+
 } // namespace
 } // namespace defocus
