@@ -479,6 +479,11 @@ cv::Mat yuvToBgr(const YuvImage& image)
     return convertYuv(image);
 }
 
+cv::Mat colorBgr(const Frame& frame)
+{
+    return frame.color.empty() && !frame.yuv.y.empty() ? yuvToBgr(frame.yuv) : frame.color;
+}
+
 void Filter::Impl::fillReport(std::size_t index, const FrameTimings& t, FrameReport& r) const
 {
     const Impl& p = *this;

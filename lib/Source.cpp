@@ -93,6 +93,7 @@ Source::Source(const SourceSettings& settings) : impl_(std::make_unique<Impl>())
         options.depth = settings.depth;
     options.depthScale = settings.depthScale;
     options.depthUnits = settings.depthUnits;
+    options.yuvColor = settings.yuvColor;
     options.width = settings.width;
     options.height = settings.height;
     options.fps = settings.fps;

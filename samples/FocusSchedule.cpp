@@ -154,7 +154,7 @@ FocusControl::FocusControl(const std::string& focus, std::optional<cv::Point2d> 
 double FocusControl::measure(const Frame& frame) const
 {
     if (point_)
-        return depthAtPoint(depthMetres(frame), frame.color.size(), *point_).value_or(std::numeric_limits<double>::quiet_NaN());
+        return depthAtPoint(depthMetres(frame), colorSize(frame), *point_).value_or(std::numeric_limits<double>::quiet_NaN());
     return medianCentreDepth(depthMetres(frame), 0.1).value_or(std::numeric_limits<double>::quiet_NaN());
 }
 
@@ -172,7 +172,7 @@ double FocusControl::focusFor(const Frame& frame, double timeS, double dtS)
         return autoM_.value_or(2.0); // no valid depth yet: 2 m, as centreDepth's fallback
     case Mode::Track:
         if (point_) {
-            const cv::Size size = frame.color.size();
+            const cv::Size size = colorSize(frame);
             if (!tracking_ && size.width > 0 && size.height > 0)
                 autofocus_.tap({point_->x / size.width, point_->y / size.height},
                                static_cast<double>(size.width) / size.height);

@@ -454,11 +454,11 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
             if (position < options.start || (position - options.start) % options.every != 0)
                 continue; // --start, --every
             ++framesIn;
-            if (point && framesIn == 1 &&
-                !(point->x < frame->color.cols && point->y < frame->color.rows)) // parsePoint: not negative
+            if (const cv::Size size = colorSize(*frame);
+                point && framesIn == 1 && !(point->x < size.width && point->y < size.height)) // parsePoint: not negative
                 throw RequestError(fmt::format("--focus-point {} is outside the {}x{} frame (X 0 to {}, Y 0 to {})",
-                                               options.focusPoint, frame->color.cols, frame->color.rows,
-                                               frame->color.cols - 1, frame->color.rows - 1));
+                                               options.focusPoint, size.width, size.height, size.width - 1,
+                                               size.height - 1));
             if (focus.readsDepth() && frame->depthScale > 0.0) {
                 // Metres once, for the focus and then the filter, not once for each.
                 frame->depth = depthMetres(*frame);
@@ -494,12 +494,17 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
             const bool sheetFrame = !options.contactSheet.empty() && frame->index == options.contactFrame;
             if (sheetFrame || inFlight == 1) {
                 receiveAll();
-                const cv::Mat image = filter.process(frame->color, depthFor(*frame), frame->timestampS);
+                const cv::Mat image = frame->color.empty() && !frame->yuv.y.empty()
+                                          ? filter.process(frame->yuv, depthFor(*frame), frame->timestampS)
+                                          : filter.process(frame->color, depthFor(*frame), frame->timestampS);
                 if (sheetFrame)
                     sheet = filter.contactSheet(); // written with the output, when the run is done
                 deliver(image, {std::move(*frame), lens.focusM});
             } else {
-                filter.submit(frame->color, depthFor(*frame), frame->timestampS);
+                if (frame->color.empty() && !frame->yuv.y.empty())
+                    filter.submit(frame->yuv, depthFor(*frame), frame->timestampS);
+                else
+                    filter.submit(frame->color, depthFor(*frame), frame->timestampS);
                 waiting.push_back({std::move(*frame), lens.focusM});
                 if (filter.framesInFlight() >= inFlight)
                     receiveOne();
@@ -622,6 +627,7 @@ int runClip(Options options, std::optional<Filter>& filter, nlohmann::json* repo
         sourceOptions.input = options.input;
         sourceOptions.depthScale = options.depthScale;
         sourceOptions.depthUnits = true;
+        sourceOptions.yuvColor = true; // a camera's YUYV or NV12 goes to the GPU as it came
         if (!options.depth.empty())
             sourceOptions.depth = options.depth;
         source = openSource(sourceOptions);

@@ -101,6 +101,7 @@ int run(const Options& o)
     sourceOptions.height = o.camera.height;
     sourceOptions.fps = o.camera.fps;
     sourceOptions.pixelFormat = o.camera.pixelFormat;
+    sourceOptions.yuvColor = true; // a camera's YUYV or NV12 goes to the GPU as it came
     std::unique_ptr<FrameSource> source = openSource(sourceOptions);
     // Cameras never block the preview; clips never drop a frame, and are decoded a frame or two
     // ahead on a thread of their own while the filter renders (sources/ReadAheadSource.hpp).
@@ -214,8 +215,8 @@ int run(const Options& o)
 
             // 2. Requests from the window, and the focus of a held frame.
             if (current && controls.tap) {
-                const cv::Mat& color = current->frame.color;
-                autofocus.tap(*controls.tap, static_cast<double>(color.cols) / color.rows);
+                const cv::Size size = colorSize(current->frame);
+                autofocus.tap(*controls.tap, static_cast<double>(size.width) / size.height);
                 if (!autofocus.retarget(current->frame.depth))
                     spdlog::warn("tap to focus: no valid depth there; the focus stays at {:.2f} m", autofocus.targetM());
                 else
@@ -264,7 +265,9 @@ int run(const Options& o)
             settings.view = controls.view;
             filter.setSettings(settings); // clamped by lensFor
             const Frame& frame = current->frame;
-            const cv::Mat image = filter.process(frame.color, frame.depth, frame.timestampS);
+            const cv::Mat image = frame.color.empty() && !frame.yuv.y.empty()
+                                      ? filter.process(frame.yuv, frame.depth, frame.timestampS)
+                                      : filter.process(frame.color, frame.depth, frame.timestampS);
             const FrameReport& report = filter.lastFrame();
             const Timings& timings = report.timings;
             if (!timings.gpu.empty())

@@ -95,6 +95,8 @@ struct SourceOptions {
     /// Pixel format asked of a colour camera (a V4L2 FourCC name: YUYV, MJPG, NV12, RGB3...);
     /// "" = the fastest it offers among those defocus decodes.
     std::string pixelFormat = {};
+    /// A colour camera's YUYV or NV12 frames come as they were captured (Frame::yuv), not as BGR.
+    bool yuvColor = false;
 };
 
 /// The units per metre openSource reads 16-bit depth at when `options.depthScale` is unset: 5000

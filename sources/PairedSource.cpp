@@ -271,8 +271,8 @@ std::optional<Frame> PairedSource::next()
         return std::nullopt;
     std::optional<DepthSample> depth = depth_->depthFor(*frame);
     if (depth && !depth->depth.image.empty()) {
-        if (!frame->color.empty())
-            checkDepthFits(frame->color.size(), frame->name, depth->depth.image.size(), depth->name);
+        if (const cv::Size size = colorSize(*frame); !size.empty())
+            checkDepthFits(size, frame->name, depth->depth.image.size(), depth->name);
         frame->depth = std::move(depth->depth.image);
         frame->depthScale = depth->depth.unitsPerMetre;
     } else {

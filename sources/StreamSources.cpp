@@ -66,6 +66,7 @@ std::unique_ptr<FrameSource> openStreamSource(const SourceOptions& options)
         colour.height = options.height;
         colour.fps = options.fps;
         colour.pixelFormat = options.pixelFormat;
+        colour.yuvColor = options.yuvColor;
         auto camera = std::make_unique<V4l2Source>(colour);
         if (!options.depth) {
             logger().warn("camera {}: no depth given; its frames pass through in focus",

@@ -198,4 +198,36 @@ cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout)
     }
 }
 
+std::optional<YuvImage> capturedYuv(std::span<const std::uint8_t> data, const PixelLayout& layout)
+{
+    const int w = layout.width, h = layout.height;
+    YuvImage image;
+    image.layout = YuvImage::Layout::Yuyv;
+    image.matrix = YuvImage::Matrix::Bt601;
+    image.range = YuvImage::Range::Limited;
+    switch (layout.fourcc) {
+    case V4L2_PIX_FMT_YUYV:
+        if (w % 2 != 0)
+            return std::nullopt;
+        image.y = view(data, h, w, CV_8UC2, strideFor(w, layout.bytesPerLine, 2)).clone();
+        break;
+    case V4L2_PIX_FMT_NV12: {
+        if (w % 2 != 0 || h % 2 != 0)
+            return std::nullopt;
+        // Y rows, then the interleaved CbCr rows at the same stride (single-plane NV12).
+        const cv::Mat planes = view(data, h + h / 2, w, CV_8UC1, strideFor(w, layout.bytesPerLine, 1));
+        if (planes.empty())
+            return std::nullopt;
+        image.layout = YuvImage::Layout::Nv12;
+        image.y = planes.rowRange(0, h).clone();
+        image.u = planes.rowRange(h, h + h / 2).reshape(2).clone();
+        break;
+    }
+    default: return std::nullopt;
+    }
+    if (image.y.empty())
+        return std::nullopt;
+    return image;
+}
+
 } // namespace defocus::v4l2

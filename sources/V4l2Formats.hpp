@@ -1,15 +1,18 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// Conversions of V4L2 pixel formats into what a Frame holds: colour formats to BGR CV_8UC3,
-// Z16 depth as 16-bit units. Pure functions on bytes, so tests check them without a camera.
+// Conversions of V4L2 pixel formats into what a Frame holds: colour formats to BGR CV_8UC3 (or
+// YUYV and NV12 kept as Y'CbCr planes), Z16 depth as 16-bit units. Pure functions on bytes, so tests check them without a camera.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 
 #include <opencv2/core.hpp>
+
+#include "defocus/Frame.hpp"
 
 namespace defocus::v4l2 {
 
@@ -67,5 +70,11 @@ cv::Mat convertZ16(std::span<const std::uint8_t> data, int width, int height, st
 /// The conversion for `layout.fourcc`: colour formats give BGR CV_8UC3, Z16 its 16-bit units.
 /// Empty for other formats, short data, or a JPEG that does not decode.
 cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout);
+
+/// YUYV and NV12 as they were captured, for the filter to upload as they are: the planes copied
+/// out of `data` (rows packed, the driver's padding dropped) into a YuvImage that owns them,
+/// BT.601 limited range as convertYuyv() and convertNv12() read them. nullopt for other
+/// formats, short data or an odd layout (the same as those conversions' empty results).
+std::optional<YuvImage> capturedYuv(std::span<const std::uint8_t> data, const PixelLayout& layout);
 
 } // namespace defocus::v4l2

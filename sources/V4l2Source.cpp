@@ -440,6 +440,7 @@ bool V4l2Source::dequeue(std::optional<Frame>& frame)
     lastSequence_ = buffer.sequence;
 
     cv::Mat image;
+    std::optional<YuvImage> yuv;
     std::string problem;
     if ((buffer.flags & V4L2_BUF_FLAG_ERROR) != 0) {
         problem = "the driver marked it as damaged";
@@ -451,12 +452,16 @@ bool V4l2Source::dequeue(std::optional<Frame>& frame)
         const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(mapped.start), used);
         if (layout_.fourcc != V4L2_PIX_FMT_MJPEG && used < v4l2::minimumFrameBytes(layout_))
             problem = fmt::format("{} bytes, a frame needs {}", used, v4l2::minimumFrameBytes(layout_));
+        else if (options_.yuvColor && options_.role == V4l2Options::Role::Color &&
+                 (yuv = v4l2::capturedYuv(bytes, layout_)))
+            image = yuv->y;
         else
             image = v4l2::convert(bytes, layout_);
         if (image.empty() && problem.empty())
             problem = fmt::format("its {} data do not decode", v4l2::fourccName(layout_.fourcc));
     }
-    // The converted image owns its pixels, so the buffer goes back to the driver at once.
+    // The converted image (or the copied planes) owns its pixels, so the buffer goes back to the
+    // driver at once.
     if (xioctl(fd_, VIDIOC_QBUF, &buffer) != 0) {
         const int error = errno;
         if (error == ENODEV || error == EIO)
@@ -486,7 +491,9 @@ bool V4l2Source::dequeue(std::optional<Frame>& frame)
     if (options_.role == V4l2Options::Role::Depth) {
         frame->depth = std::move(image);
         frame->depthScale = options_.unitsPerMetre;
-    } else
+    } else if (yuv)
+        frame->yuv = std::move(*yuv);
+    else
         frame->color = std::move(image);
     frame->timestampS = believable ? driverTime : now;
     frame->index = delivered_++;

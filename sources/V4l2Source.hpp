@@ -36,6 +36,9 @@ struct V4l2Options {
     /// Pixel format to ask for by fourcc ("MJPG", "NV12", "Z16"); empty: the first the node lists
     /// of YUYV, NV12, BGR3, RGB3, MJPG, GREY that reaches `fps` at the size (colour), Z16 (depth).
     std::string pixelFormat;
+    /// Colour in YUYV or NV12 comes as it was captured (Frame::yuv, Frame::color empty) for the
+    /// filter to upload as it is; other formats, and colour when this is false, come as BGR.
+    bool yuvColor = false;
     /// Units per metre of Z16 depth (> 0); RealSense and most depth cameras give millimetres.
     double unitsPerMetre = 1000.0;
     /// mmap buffers to ask for, 3..32: one with the driver filling it, one being converted, one

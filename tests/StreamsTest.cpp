@@ -17,6 +17,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "defocus/Filter.hpp"
 #include "sources/FrameSource.hpp"
 #include "sources/PairedSource.hpp"
 #include "sources/V4l2Formats.hpp"
@@ -104,6 +105,43 @@ TEST(V4l2Formats, YuyvWithRowPadding)
     // The dispatcher gives the same image.
     const cv::Mat dispatched = v4l2::convert(data, {V4L2_PIX_FMT_YUYV, 4, 2, 12});
     EXPECT_EQ(cv::norm(dispatched, bgr, cv::NORM_INF), 0.0);
+}
+
+TEST(V4l2Formats, CapturedYuvKeepsThePlanesAsTheFilterReadsThem)
+{
+    // Catches a camera's Y'CbCr kept for the GPU (SourceSettings::yuvColor) other than the BGR it
+    // gave before: the driver's row padding read as pixels, NV12's chroma rows taken from the
+    // wrong offset, the layout or the matrix mislabelled (yuvToBgr() then differs from the CPU
+    // conversion by more than its one level of rounding), or planes that still view the capture
+    // buffer, which the driver fills again once it is queued.
+    Bytes yuyv = {16, 128, 235, 128, 81, 90, 81, 240, 0xEE, 0xEE, 0xEE, 0xEE,
+                  41, 240, 41, 110, 145, 54, 145, 34, 0xEE, 0xEE, 0xEE, 0xEE};
+    Bytes nv12 = {16, 235, 81, 81, 0xEE, 0xEE, 126, 126, 81, 81, 0xEE, 0xEE, 128, 128, 90, 240, 0xEE, 0xEE};
+    struct Case {
+        const char* name;
+        Bytes* data;
+        v4l2::PixelLayout layout;
+        YuvImage::Layout expected;
+    };
+    for (const Case& c : {Case{"YUYV", &yuyv, {V4L2_PIX_FMT_YUYV, 4, 2, 12}, YuvImage::Layout::Yuyv},
+                          Case{"NV12", &nv12, {V4L2_PIX_FMT_NV12, 4, 2, 6}, YuvImage::Layout::Nv12}}) {
+        const cv::Mat bgr = v4l2::convert(*c.data, c.layout);
+        const std::optional<YuvImage> yuv = v4l2::capturedYuv(*c.data, c.layout);
+        ASSERT_TRUE(yuv) << c.name;
+        EXPECT_EQ(yuv->layout, c.expected) << c.name;
+        EXPECT_EQ(yuv->matrix, YuvImage::Matrix::Bt601) << c.name;
+        EXPECT_EQ(yuv->range, YuvImage::Range::Limited) << c.name;
+        ASSERT_EQ(yuv->y.size(), cv::Size(4, 2)) << c.name;
+        const cv::Mat fromPlanes = yuvToBgr(*yuv);
+        EXPECT_LE(cv::norm(fromPlanes, bgr, cv::NORM_INF), 1.0) << c.name << ": " << fromPlanes << " against " << bgr;
+        std::fill(c.data->begin(), c.data->end(), std::uint8_t{0x55}); // the driver fills the buffer again
+        EXPECT_EQ(cv::norm(yuvToBgr(*yuv), fromPlanes, cv::NORM_INF), 0.0) << c.name << ": the planes view the buffer";
+    }
+    EXPECT_FALSE(v4l2::capturedYuv(std::span(yuyv).first(23), {V4L2_PIX_FMT_YUYV, 4, 2, 12})) << "short data";
+    EXPECT_FALSE(v4l2::capturedYuv(yuyv, {V4L2_PIX_FMT_YUYV, 3, 2, 12})) << "odd width";
+    EXPECT_FALSE(v4l2::capturedYuv(std::span(nv12).first(17), {V4L2_PIX_FMT_NV12, 4, 2, 6})) << "short data";
+    EXPECT_FALSE(v4l2::capturedYuv(nv12, {V4L2_PIX_FMT_NV12, 4, 1, 6})) << "odd height";
+    EXPECT_FALSE(v4l2::capturedYuv(yuyv, {V4L2_PIX_FMT_RGB24, 4, 2, 12})) << "not Y'CbCr";
 }
 
 TEST(V4l2Formats, Nv12)

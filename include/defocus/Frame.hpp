@@ -3,7 +3,7 @@
 // metres, or in the units a 16-bit file or camera stored), when it was captured and where it
 // came from (for messages). defocus::Source gives them; the command line's sources and sinks pass
 // them along. defocus::YuvImage: colour as a video decoder or camera gives it, which the filter
-// also takes.
+// also takes and a frame may hold instead of BGR.
 #pragma once
 
 #include <cstddef>
@@ -11,29 +11,9 @@
 
 #include <opencv2/core.hpp>
 
-namespace defocus {
+#include "defocus/Export.hpp"
 
-struct Frame {
-    /// Colour, BGR channel order: CV_8UC3 sRGB-encoded, or CV_32FC3 scene-linear (EXR and other
-    /// float inputs; values well above 1 are kept).
-    cv::Mat color;
-    /// Depth along the view axis, its own size (Filter::process resizes it to the colour by nearest
-    /// neighbour): CV_32FC1 metres, where 0, negative, NaN and infinities mean "no measurement";
-    /// or, from a Source with SourceSettings::depthUnits, CV_16UC1 as a 16-bit depth file or camera
-    /// stored it, `depthScale` units per metre, 0 = no measurement (what Filter::process uploads
-    /// as it is with Settings::depthScale the same). depthMetres() gives metres either way.
-    /// Empty: no depth at all; the frame passes through in focus.
-    cv::Mat depth;
-    /// Capture time, seconds, on the source's clock (file names, TUM lists, a camera's
-    /// CLOCK_MONOTONIC); 0 where unknown.
-    double timestampS = 0.0;
-    /// Frames since the start, from 0.
-    std::size_t index = 0;
-    /// Where it came from, for messages, e.g. "rgb/1305031102.175304.png".
-    std::string name;
-    /// Units per metre of CV_16UC1 `depth` (> 0); 0 where `depth` is metres or empty.
-    double depthScale = 0.0;
-};
+namespace defocus {
 
 /// A colour image as video decoders and cameras give it: 8-bit Y'CbCr 4:2:0, planar (I420: Y, then
 /// Cb, then Cr) or semi-planar (NV12: Y, then Cb and Cr interleaved), or 4:2:2 packed as webcams
@@ -64,6 +44,34 @@ struct YuvImage {
     cv::Mat v;
 };
 
+struct Frame {
+    /// Colour, BGR channel order: CV_8UC3 sRGB-encoded, or CV_32FC3 scene-linear (EXR and other
+    /// float inputs; values well above 1 are kept). Empty where `yuv` holds the colour.
+    cv::Mat color;
+    /// Depth along the view axis, its own size (Filter::process resizes it to the colour by nearest
+    /// neighbour): CV_32FC1 metres, where 0, negative, NaN and infinities mean "no measurement";
+    /// or, from a Source with SourceSettings::depthUnits, CV_16UC1 as a 16-bit depth file or camera
+    /// stored it, `depthScale` units per metre, 0 = no measurement (what Filter::process uploads
+    /// as it is with Settings::depthScale the same). depthMetres() gives metres either way.
+    /// Empty: no depth at all; the frame passes through in focus.
+    cv::Mat depth;
+    /// Capture time, seconds, on the source's clock (file names, TUM lists, a camera's
+    /// CLOCK_MONOTONIC); 0 where unknown.
+    double timestampS = 0.0;
+    /// Frames since the start, from 0.
+    std::size_t index = 0;
+    /// Where it came from, for messages, e.g. "rgb/1305031102.175304.png".
+    std::string name;
+    /// Units per metre of CV_16UC1 `depth` (> 0); 0 where `depth` is metres or empty.
+    double depthScale = 0.0;
+    /// Colour as a camera captured it, from a Source with SourceSettings::yuvColor where the
+    /// camera sends Y'CbCr (YUYV, NV12): its planes, owned by the frame, for Filter::process to
+    /// upload as they are; `color` is then empty. Otherwise its planes are empty. colorBgr()
+    /// gives BGR either way.
+    YuvImage yuv = {};
+};
+
+
 /// `frame.depth` as CV_32FC1 metres: 16-bit depth divided by its depthScale (0 stays 0), metres
 /// as they are (the same pixels, not a copy), empty as it is.
 inline cv::Mat depthMetres(const Frame& frame)
@@ -74,6 +82,16 @@ inline cv::Mat depthMetres(const Frame& frame)
     cv::Mat metres;
     frame.depth.convertTo(metres, CV_32F, 1.0 / frame.depthScale);
     return metres;
+}
+
+/// `frame.color`, or where that is empty and `frame.yuv` holds the colour, yuvToBgr() of it
+/// (include/defocus/Filter.hpp): CV_8UC3 BGR.
+DEFOCUS_API cv::Mat colorBgr(const Frame& frame);
+
+/// The size of the frame's colour, `color` or `yuv`; 0x0 where it has none.
+inline cv::Size colorSize(const Frame& frame)
+{
+    return frame.color.empty() ? frame.yuv.y.size() : frame.color.size();
 }
 
 } // namespace defocus

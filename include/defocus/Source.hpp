@@ -65,6 +65,11 @@ struct SourceSettings {
     /// Settings::depthScale to the same; half the bytes of metres, converted where the depth is
     /// prepared). Otherwise every frame's depth is CV_32FC1 metres.
     bool depthUnits = false;
+    /// A colour camera's Y'CbCr frames (YUYV, NV12) come as they were captured: Frame::yuv holds
+    /// their planes and Frame::color is empty, for Filter::process to upload as they are (half
+    /// the bytes of BGR, converted on the GPU; colorBgr() gives BGR). Other inputs and formats
+    /// come as BGR either way.
+    bool yuvColor = false;
     /// A camera is asked for this size (pixels) and rate (Hz); it answers with the nearest it has.
     int width = 640;
     int height = 480;
