@@ -3,6 +3,7 @@
 #include "bench/BenchThroughput.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <ctime>
 #include <optional>
@@ -27,8 +28,9 @@ double threadCpuMs()
     return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
-/// `bgr` as I420 planes (OpenCV's BT.601, limited range).
-YuvImage i420Of(const cv::Mat& bgr)
+/// `bgr` (even width and height) as planes of `layout` (OpenCV's BT.601 I420, limited range;
+/// NV12 its chroma interleaved; YUYV each pair's Cb and Cr from its 2x2 block's).
+YuvImage yuvOf(const cv::Mat& bgr, YuvImage::Layout layout)
 {
     cv::Mat packed;
     cv::cvtColor(bgr, packed, cv::COLOR_BGR2YUV_I420);
@@ -38,14 +40,31 @@ YuvImage i420Of(const cv::Mat& bgr)
     yuv.y = packed.rowRange(0, h);
     yuv.u = cv::Mat(h / 2, w / 2, CV_8UC1, packed.ptr(h));
     yuv.v = cv::Mat(h / 2, w / 2, CV_8UC1, packed.ptr(h) + (w / 2) * (h / 2));
+    if (layout == YuvImage::Layout::Nv12) {
+        cv::Mat chroma;
+        cv::merge(std::vector<cv::Mat>{yuv.u, yuv.v}, chroma);
+        yuv = {YuvImage::Layout::Nv12, yuv.matrix, yuv.range, yuv.y, chroma, {}};
+    } else if (layout == YuvImage::Layout::Yuyv) {
+        cv::Mat pairs(h, w, CV_8UC2);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                pairs.at<cv::Vec2b>(y, x) = {yuv.y.at<std::uint8_t>(y, x),
+                                             (x % 2 == 0 ? yuv.u : yuv.v).at<std::uint8_t>(y / 2, x / 2)};
+        yuv = {YuvImage::Layout::Yuyv, yuv.matrix, yuv.range, pairs, {}, {}};
+    }
     return yuv;
 }
 
-/// --versus-i420: the table of I420 in flight against BGR in flight, per size.
-int runVersusI420(const ThroughputOptions& options, const std::vector<Frame>& clip, Filter& filter)
+/// --versus-yuv: the table of Y'CbCr in flight against BGR in flight, per size.
+int runVersusYuv(const ThroughputOptions& options, const std::vector<Frame>& clip, Filter& filter)
 {
-    fmt::print("{:>11} | {:>22} | {:>22} | {:>9} | {:>9}\n", "size", "BGR ms (fps)", "I420 ms (fps)", "I420/BGR",
-               "CPU ms");
+    const YuvImage::Layout layout = options.versusYuv == "yuyv"   ? YuvImage::Layout::Yuyv
+                                    : options.versusYuv == "nv12" ? YuvImage::Layout::Nv12
+                                                                  : YuvImage::Layout::I420;
+    std::string name = options.versusYuv;
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+    fmt::print("{:>11} | {:>22} | {:>22} | {:>9} | {:>9}\n", "size", "BGR ms (fps)", name + " ms (fps)",
+               name + "/BGR", "CPU ms");
     int status = kExitDone;
     for (const cv::Size size : options.sizes) {
         std::vector<YuvImage> yuv;
@@ -54,7 +73,7 @@ int runVersusI420(const ThroughputOptions& options, const std::vector<Frame>& cl
             cv::Mat color, d;
             cv::resize(f.color, color, size, 0, 0, cv::INTER_AREA);
             cv::resize(f.depth, d, size, 0, 0, cv::INTER_NEAREST);
-            yuv.push_back(i420Of(color));
+            yuv.push_back(yuvOf(color, layout));
             bgr.push_back(yuvToBgr(yuv.back())); // what the filter makes of the planes: the same frames
             depth.push_back(d);
         }
@@ -96,8 +115,8 @@ int runVersusI420(const ThroughputOptions& options, const std::vector<Frame>& cl
             cv::Mat diff;
             cv::absdiff(bgrOut[i], yuvOut[i], diff);
             if (cv::countNonZero(diff.reshape(1)) != 0) {
-                fmt::print(stderr, "defocus-bench: error: {}x{} frame {}: I420 differs from its BGR\n", size.width,
-                           size.height, i);
+                fmt::print(stderr, "defocus-bench: error: {}x{} frame {}: {} differs from its BGR\n", size.width,
+                           size.height, i, name);
                 status = kExitBadInput;
             }
         }
@@ -107,8 +126,8 @@ int runVersusI420(const ThroughputOptions& options, const std::vector<Frame>& cl
                    median(yuvCpu));
     }
     fmt::print("ms: wall per frame with {} in flight, median of the passes; CPU ms: the calling thread's CPU time "
-               "per frame, BGR then I420\n",
-               Filter::kFramesInFlight);
+               "per frame, BGR then {}\n",
+               Filter::kFramesInFlight, name);
     return status;
 }
 
@@ -137,8 +156,8 @@ int runThroughput(const ThroughputOptions& options)
     Filter filter(settings);
     fmt::print("{} frames of {} per pass, {} passes per way, interleaved; {} preset; on {}\n", options.frames,
                options.data, options.passes, options.preset, filter.renderer());
-    if (options.versusI420)
-        return runVersusI420(options, clip, filter);
+    if (!options.versusYuv.empty())
+        return runVersusYuv(options, clip, filter);
     fmt::print("{:>11} | {:>22} | {:>22} | {:>9} | {:>9}\n", "size", "one at a time ms (fps)",
                fmt::format("{} in flight ms (fps)", Filter::kFramesInFlight), "new/old", "CPU ms");
     int status = kExitDone;

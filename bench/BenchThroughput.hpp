@@ -5,6 +5,7 @@
 //   defocus-bench throughput                                     (640x480 and 1920x1080, balanced)
 //   defocus-bench throughput --sizes 3840x2160 --frames 60 --passes 5 --quality high
 //   defocus-bench throughput --versus-i420                       (colour as I420 planes against BGR)
+//   defocus-bench throughput --versus-yuv yuyv                   (a webcam's YUYV, or nv12, against BGR)
 #pragma once
 
 #include <string>
@@ -20,9 +21,11 @@ struct ThroughputOptions {
     std::string preset = "balanced";                        ///< quality preset
     int frames = 30;                                        ///< frames per timed pass
     int passes = 3;                                         ///< passes per mode, interleaved
-    /// Instead: frames in flight with the colour as I420 planes against the same frames as BGR
-    /// (yuvToBgr() of them), interleaved, and that both give the same bytes.
-    bool versusI420 = false;
+    /// Instead: frames in flight with the colour as Y'CbCr planes of this layout ("i420", "nv12"
+    /// or "yuyv"; OpenCV's BT.601 limited range) against the same frames as BGR (yuvToBgr() of
+    /// them), interleaved, and that both give the same bytes. Empty: one at a time against in
+    /// flight.
+    std::string versusYuv;
 };
 
 /// Prints a table per size and checks that both ways give the same bytes; returns the exit

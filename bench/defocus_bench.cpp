@@ -684,9 +684,12 @@ CLI::App* declareThroughput(CLI::App& app, defocus::ThroughputOptions& o)
     sub->add_option("--passes", o.passes, "Timed passes per way, interleaved")
         ->capture_default_str()
         ->check(cli::between(1, 1000));
-    sub->add_flag("--versus-i420", o.versusI420,
-                  "Instead: frames in flight with the colour as I420 planes against the same frames as BGR, "
-                  "interleaved, and a check that both give the same bytes");
+    sub->add_option("--versus-yuv", o.versusYuv,
+                    "Instead: frames in flight with the colour as Y'CbCr planes (i420, nv12 or a webcam's yuyv) "
+                    "against the same frames as BGR, interleaved, and a check that both give the same bytes")
+        ->check(CLI::IsMember({"i420", "nv12", "yuyv"}));
+    sub->add_flag_callback(
+        "--versus-i420", [&o] { o.versusYuv = "i420"; }, "The same as --versus-yuv i420");
     return sub;
 }
 

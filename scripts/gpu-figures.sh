@@ -83,10 +83,13 @@ case ${1:-} in
     # Colour as I420 planes (uploaded as they came, converted on the GPU) against BGR, in flight.
     step i420 "$unpacked/bin/defocus-bench" throughput --versus-i420 --sizes "$sizes" --frames "$frames" --passes 3 ||
       echo "gpu-figures: I420 not measured (see $out/i420.txt)"
+    # A webcam's YUYV the same way.
+    step yuyv "$unpacked/bin/defocus-bench" throughput --versus-yuv yuyv --sizes "$sizes" --frames "$frames" --passes 3 ||
+      echo "gpu-figures: YUYV not measured (see $out/yuyv.txt)"
     # Writing a 1080p folder output behind the filter on 1 to 8 encoding threads.
     step write "$unpacked/bin/defocus-bench" write --size 1920x1080 --frames 48 --threads 1,2,4,8 --passes 3 ||
       echo "gpu-figures: writing not measured (see $out/write.txt)"
-    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, prep.txt, bench-prep.json, compute.txt, bench-compute.json, frame-*.exr, apertures-*.txt, read.txt, i420.txt, write.txt"
+    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, prep.txt, bench-prep.json, compute.txt, bench-compute.json, frame-*.exr, apertures-*.txt, read.txt, i420.txt, yuyv.txt, write.txt"
     ;;
   *)
     echo "usage: scripts/gpu-figures.sh pack [BUILD_DIR] | run [OUT_DIR]" >&2
