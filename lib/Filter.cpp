@@ -472,6 +472,29 @@ cv::Mat Filter::process(const YuvImage& color, const cv::Mat& depth, double time
     return impl_->processAlone({}, depth, timestampS, &color);
 }
 
+namespace {
+
+/// A Source's frame's colour is its planes where it has no BGR.
+bool holdsYuv(const Frame& frame)
+{
+    return frame.color.empty() && !frame.yuv.y.empty();
+}
+
+/// 16-bit depth in other units than `unitsPerMetre` as metres; anything else as it is.
+cv::Mat depthIn(const Frame& frame, double unitsPerMetre)
+{
+    const bool otherUnits = frame.depth.type() == CV_16UC1 && frame.depthScale > 0.0 && frame.depthScale != unitsPerMetre;
+    return otherUnits ? depthMetres(frame) : frame.depth;
+}
+
+} // namespace
+
+cv::Mat Filter::process(const Frame& frame)
+{
+    const cv::Mat depth = depthIn(frame, settings().depthScale);
+    return holdsYuv(frame) ? process(frame.yuv, depth, frame.timestampS) : process(frame.color, depth, frame.timestampS);
+}
+
 cv::Mat yuvToBgr(const YuvImage& image)
 {
     if (const std::string problem = yuvProblem(image); !problem.empty())
@@ -481,7 +504,7 @@ cv::Mat yuvToBgr(const YuvImage& image)
 
 cv::Mat colorBgr(const Frame& frame)
 {
-    return frame.color.empty() && !frame.yuv.y.empty() ? yuvToBgr(frame.yuv) : frame.color;
+    return holdsYuv(frame) ? yuvToBgr(frame.yuv) : frame.color;
 }
 
 void Filter::Impl::fillReport(std::size_t index, const FrameTimings& t, FrameReport& r) const
@@ -604,6 +627,15 @@ void Filter::submit(const cv::Mat& color, const cv::Mat& depth, double timestamp
 void Filter::submit(const YuvImage& color, const cv::Mat& depth, double timestampS)
 {
     impl_->submitOwnContext({}, depth, timestampS, &color);
+}
+
+void Filter::submit(const Frame& frame)
+{
+    const cv::Mat depth = depthIn(frame, settings().depthScale);
+    if (holdsYuv(frame))
+        submit(frame.yuv, depth, frame.timestampS);
+    else
+        submit(frame.color, depth, frame.timestampS);
 }
 
 std::optional<cv::Mat> Filter::receive()

@@ -426,11 +426,6 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
         readbackMs += t.readbackMs;
         progress.update(++timed);
     };
-    // A frame's depth as the filter takes it: 16-bit depth as it was read, in the settings' units
-    // per metre (the filter converts it where it prepares depth); metres where the units differ.
-    const auto depthFor = [&](const Frame& frame) {
-        return frame.depthScale > 0.0 && frame.depthScale != settings.depthScale ? depthMetres(frame) : frame.depth;
-    };
     const auto receiveOne = [&] {
         const std::optional<cv::Mat> image = filter.receive();
         deliver(*image, waiting.front());
@@ -494,17 +489,12 @@ int processClip(const Options& options, FrameSource& source, const DemoSource* d
             const bool sheetFrame = !options.contactSheet.empty() && frame->index == options.contactFrame;
             if (sheetFrame || inFlight == 1) {
                 receiveAll();
-                const cv::Mat image = frame->color.empty() && !frame->yuv.y.empty()
-                                          ? filter.process(frame->yuv, depthFor(*frame), frame->timestampS)
-                                          : filter.process(frame->color, depthFor(*frame), frame->timestampS);
+                const cv::Mat image = filter.process(*frame);
                 if (sheetFrame)
                     sheet = filter.contactSheet(); // written with the output, when the run is done
                 deliver(image, {std::move(*frame), lens.focusM});
             } else {
-                if (frame->color.empty() && !frame->yuv.y.empty())
-                    filter.submit(frame->yuv, depthFor(*frame), frame->timestampS);
-                else
-                    filter.submit(frame->color, depthFor(*frame), frame->timestampS);
+                filter.submit(*frame);
                 waiting.push_back({std::move(*frame), lens.focusM});
                 if (filter.framesInFlight() >= inFlight)
                     receiveOne();

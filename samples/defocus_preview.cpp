@@ -265,9 +265,7 @@ int run(const Options& o)
             settings.view = controls.view;
             filter.setSettings(settings); // clamped by lensFor
             const Frame& frame = current->frame;
-            const cv::Mat image = frame.color.empty() && !frame.yuv.y.empty()
-                                      ? filter.process(frame.yuv, frame.depth, frame.timestampS)
-                                      : filter.process(frame.color, frame.depth, frame.timestampS);
+            const cv::Mat image = filter.process(frame);
             const FrameReport& report = filter.lastFrame();
             const Timings& timings = report.timings;
             if (!timings.gpu.empty())

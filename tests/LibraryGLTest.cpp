@@ -760,6 +760,65 @@ TEST(LibraryYuv, YuvInIsTheResultOfItsBgrOnEveryPreset)
     }
 }
 
+// Defects caught: process(Frame) or submit(Frame) taking the wrong colour (BGR where the frame
+// holds Y'CbCr planes, or the reverse), 16-bit depth read in the settings' units when the frame
+// states others (the clip's 5000 a metre read as 1000: every depth five times farther), or
+// converted to metres when the units agree, or the frame's timestamp left out (the follow
+// autofocus then steps by 1/30 s instead of the frames' 0.5 s apart).
+TEST_F(Library, AFrameAsASourceGivesItIsItsImagesResult)
+{
+    defocus::Frame frame;
+    frame.color = color_;
+    frame.depth = depth_; // 16-bit, 5000 a metre, as the settings say
+    frame.depthScale = 5000.0;
+    const cv::Mat direct = filter_->process(color_, depth_);
+    EXPECT_TRUE(identical(filter_->process(frame), direct)) << "BGR, the settings' units";
+
+    defocus::Settings millimetres = settings_;
+    millimetres.depthScale = 1000.0;
+    filter_->setSettings(millimetres);
+    EXPECT_TRUE(identical(filter_->process(frame), filter_->process(color_, defocus::depthMetres(frame))))
+        << "BGR, other units than the settings'";
+    EXPECT_FALSE(identical(filter_->process(frame), filter_->process(color_, depth_)))
+        << "the clip read in millimetres must differ, or the case above shows nothing";
+    filter_->setSettings(settings_);
+
+    defocus::Frame planes = frame;
+    planes.color = cv::Mat();
+    planes.yuv = opencvYuv(color_, defocus::YuvImage::Layout::Nv12);
+    planes.yuv.matrix = defocus::YuvImage::Matrix::Bt601;
+    const cv::Mat fromPlanes = filter_->process(planes.yuv, depth_);
+    EXPECT_TRUE(identical(filter_->process(planes), fromPlanes)) << "Y'CbCr planes";
+    EXPECT_TRUE(identical(defocus::colorBgr(planes), defocus::yuvToBgr(planes.yuv)));
+    EXPECT_EQ(defocus::colorSize(planes), color_.size());
+
+    filter_->submit(planes);
+    filter_->submit(frame);
+    EXPECT_TRUE(identical(filter_->receive().value(), fromPlanes)) << "Y'CbCr planes, in flight";
+    EXPECT_TRUE(identical(filter_->receive().value(), direct)) << "BGR, in flight";
+
+    // The timestamp: follow autofocus moves by the time between frames.
+    defocus::Settings follow = settings_;
+    follow.autofocus.mode = defocus::AutofocusOptions::Mode::Follow;
+    const cv::Mat near(depth_.size(), CV_16UC1, cv::Scalar(2500)); // 0.5 m: the focus glides there
+    filter_->setSettings(follow);
+    const auto focusAfterTwo = [&](bool asFrames, double firstS, double secondS) {
+        filter_->reset();
+        for (int i = 0; i < 2; ++i) {
+            frame.depth = i == 0 ? depth_ : near;
+            frame.timestampS = i == 0 ? firstS : secondS;
+            if (asFrames)
+                filter_->process(frame);
+            else
+                filter_->process(color_, frame.depth, frame.timestampS);
+        }
+        return filter_->lastFrame().focusM;
+    };
+    const double followed = focusAfterTwo(false, 1.0, 1.5); // 0 would be "unknown"
+    EXPECT_EQ(focusAfterTwo(true, 1.0, 1.5), followed);
+    EXPECT_NE(focusAfterTwo(true, 0.0, 0.0), followed) << "the frames' 0.5 s must show, or the case above shows nothing";
+}
+
 // Defects caught: SourceSettings::readThreads not reaching the reading (no frame is read before
 // next() asks: the reads of frames 1 and 2 are watched for with inotify, right after the Source is
 // made), and frames decoded ahead given in another order, paired with another depth or changed.

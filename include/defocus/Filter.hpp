@@ -218,6 +218,10 @@ public:
     /// of BGR's 3) and become colour there; on a software renderer the CPU converts them. Throws InputError for planes
     /// of the wrong type or size.
     cv::Mat process(const YuvImage& color, const cv::Mat& depth, double timestampS = 0.0);
+    /// process() of a frame as a Source gives it: its colour (`color`, or `yuv` where `color` is
+    /// empty), its depth and its timestamp. 16-bit depth whose Frame::depthScale is not
+    /// Settings::depthScale goes in as metres (depthMetres()); otherwise as it is.
+    cv::Mat process(const Frame& frame);
     /// process() for a frame in textures of the caller's context (ContextOptions::callerContext;
     /// otherwise it throws InputError): the same result as process() of the same images, byte for
     /// byte, into `frame.output` (Settings::output is taken as Srgb8). Call it on the thread where
@@ -253,6 +257,8 @@ public:
     void submit(const cv::Mat& color, const cv::Mat& depth, double timestampS = 0.0);
     /// submit() of Y'CbCr colour, as process() takes it; its planes are referenced until received.
     void submit(const YuvImage& color, const cv::Mat& depth, double timestampS = 0.0);
+    /// submit() of a frame as a Source gives it, as process(const Frame&) takes it.
+    void submit(const Frame& frame);
     std::optional<cv::Mat> receive();
     /// Frames submitted and not yet received.
     std::size_t framesInFlight() const;
