@@ -198,13 +198,31 @@ cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout)
     }
 }
 
+YuvEncoding yuvEncoding(std::uint32_t colorspace, std::uint32_t ycbcrEnc, std::uint32_t quantization)
+{
+    if (ycbcrEnc == V4L2_YCBCR_ENC_DEFAULT)
+        ycbcrEnc = V4L2_MAP_YCBCR_ENC_DEFAULT(colorspace);
+    if (quantization == V4L2_QUANTIZATION_DEFAULT)
+        quantization = V4L2_MAP_QUANTIZATION_DEFAULT(false, colorspace, ycbcrEnc);
+    YuvEncoding encoding;
+    encoding.range = quantization == V4L2_QUANTIZATION_FULL_RANGE ? YuvImage::Range::Full : YuvImage::Range::Limited;
+    switch (ycbcrEnc) {
+    case V4L2_YCBCR_ENC_601:
+    case V4L2_YCBCR_ENC_XV601: break;
+    case V4L2_YCBCR_ENC_709:
+    case V4L2_YCBCR_ENC_XV709: encoding.matrix = YuvImage::Matrix::Bt709; break;
+    default: encoding.supported = false; break;
+    }
+    return encoding;
+}
+
 std::optional<YuvImage> capturedYuv(std::span<const std::uint8_t> data, const PixelLayout& layout)
 {
     const int w = layout.width, h = layout.height;
     YuvImage image;
     image.layout = YuvImage::Layout::Yuyv;
-    image.matrix = YuvImage::Matrix::Bt601;
-    image.range = YuvImage::Range::Limited;
+    image.matrix = layout.matrix;
+    image.range = layout.range;
     switch (layout.fourcc) {
     case V4L2_PIX_FMT_YUYV:
         if (w % 2 != 0)

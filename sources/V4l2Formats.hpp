@@ -32,7 +32,24 @@ struct PixelLayout {
     int width = 0;                ///< pixels, > 0
     int height = 0;               ///< pixels, > 0
     std::size_t bytesPerLine = 0; ///< stride of the first plane in bytes; 0 = tightly packed
+    /// YUYV and NV12: the encoding the driver states (yuvEncoding()), for capturedYuv().
+    YuvImage::Matrix matrix = YuvImage::Matrix::Bt601;
+    YuvImage::Range range = YuvImage::Range::Limited;
 };
+
+/// How a driver's Y'CbCr is encoded, from VIDIOC_S_FMT's answer.
+struct YuvEncoding {
+    YuvImage::Matrix matrix = YuvImage::Matrix::Bt601;
+    YuvImage::Range range = YuvImage::Range::Limited;
+    /// False where the matrix is one YuvImage has not (BT.2020, SMPTE 240M): BT.601 stands in.
+    bool supported = true;
+};
+/// The encoding of `colorspace`, `ycbcrEnc` and `quantization` (v4l2_pix_format's fields; pass
+/// the DEFAULT values where the driver has not set priv to V4L2_PIX_FMT_PRIV_MAGIC), their
+/// defaults resolved as V4L2 resolves them (V4L2_MAP_YCBCR_ENC_DEFAULT,
+/// V4L2_MAP_QUANTIZATION_DEFAULT): BT.709 for REC709 and DCI-P3, full range for JPEG, and
+/// otherwise BT.601 limited range, what UVC webcams and vivid at SD sizes send.
+YuvEncoding yuvEncoding(std::uint32_t colorspace, std::uint32_t ycbcrEnc, std::uint32_t quantization);
 
 /// The stride `layout` implies: its bytesPerLine, or the packed stride when that is 0. 0 for
 /// MJPEG (no rows).
@@ -73,8 +90,9 @@ cv::Mat convert(std::span<const std::uint8_t> data, const PixelLayout& layout);
 
 /// YUYV and NV12 as they were captured, for the filter to upload as they are: the planes copied
 /// out of `data` (rows packed, the driver's padding dropped) into a YuvImage that owns them,
-/// BT.601 limited range as convertYuyv() and convertNv12() read them. nullopt for other
-/// formats, short data or an odd layout (the same as those conversions' empty results).
+/// with the layout's matrix and range (convertYuyv() and convertNv12() read BT.601 limited
+/// range whatever the driver says). nullopt for other formats, short data or an odd layout (the
+/// same as those conversions' empty results).
 std::optional<YuvImage> capturedYuv(std::span<const std::uint8_t> data, const PixelLayout& layout);
 
 } // namespace defocus::v4l2

@@ -309,12 +309,21 @@ void V4l2Source::setFormat(std::uint32_t fourcc, const std::vector<std::uint32_t
             layout_.bytesPerLine = 0;
     }
     const bool yuv = got.pixelformat == V4L2_PIX_FMT_YUYV || got.pixelformat == V4L2_PIX_FMT_NV12;
-    if (yuv && got.priv == V4L2_PIX_FMT_PRIV_MAGIC &&
-        (got.quantization == V4L2_QUANTIZATION_FULL_RANGE ||
-         (got.ycbcr_enc != V4L2_YCBCR_ENC_DEFAULT && got.ycbcr_enc != V4L2_YCBCR_ENC_601)))
-        logger().warn("camera {}: the driver encodes {} with Y'CbCr encoding {} and quantization {}; "
-                     "defocus reads BT.601 limited range, so colours will be slightly off", dev,
-                     v4l2::fourccName(got.pixelformat), got.ycbcr_enc, got.quantization);
+    // The extended fields count only where the driver says it filled them.
+    const bool extended = got.priv == V4L2_PIX_FMT_PRIV_MAGIC;
+    const v4l2::YuvEncoding encoding =
+        v4l2::yuvEncoding(got.colorspace, extended ? got.ycbcr_enc : std::uint32_t{V4L2_YCBCR_ENC_DEFAULT},
+                          extended ? got.quantization : std::uint32_t{V4L2_QUANTIZATION_DEFAULT});
+    layout_.matrix = encoding.matrix;
+    layout_.range = encoding.range;
+    // Kept as captured (yuvColor), the planes go to the filter with the driver's matrix and range;
+    // made BGR here, they are read as BT.601 limited range.
+    const bool bt601Limited = encoding.matrix == YuvImage::Matrix::Bt601 && encoding.range == YuvImage::Range::Limited;
+    if (yuv && (!encoding.supported || (!options_.yuvColor && !bt601Limited)))
+        logger().warn("camera {}: the driver encodes {} with colorspace {}, Y'CbCr encoding {} and quantization {}; "
+                     "defocus reads {}, so colours will be slightly off", dev, v4l2::fourccName(got.pixelformat),
+                     got.colorspace, got.ycbcr_enc, got.quantization,
+                     encoding.supported ? "BT.601 limited range" : "BT.601 in its place");
 }
 
 void V4l2Source::setFrameRate()

@@ -144,6 +144,47 @@ TEST(V4l2Formats, CapturedYuvKeepsThePlanesAsTheFilterReadsThem)
     EXPECT_FALSE(v4l2::capturedYuv(yuyv, {V4L2_PIX_FMT_RGB24, 4, 2, 12})) << "not Y'CbCr";
 }
 
+TEST(V4l2Formats, CapturedYuvKeepsTheDriversEncoding)
+{
+    // Catches the driver's stated encoding lost on the way to the filter: an HD webcam's BT.709 or
+    // a full-range (JPEG) stream read as BT.601 limited range tints and flattens its colours; and
+    // V4L2's defaults resolved otherwise than the kernel resolves them.
+    using M = YuvImage::Matrix;
+    using R = YuvImage::Range;
+    struct Case {
+        std::uint32_t colorspace, ycbcr, quantization;
+        M matrix;
+        R range;
+        bool supported;
+    };
+    const Case cases[] = {
+        {V4L2_COLORSPACE_SMPTE170M, V4L2_YCBCR_ENC_DEFAULT, V4L2_QUANTIZATION_DEFAULT, M::Bt601, R::Limited, true},
+        {V4L2_COLORSPACE_SRGB, V4L2_YCBCR_ENC_DEFAULT, V4L2_QUANTIZATION_DEFAULT, M::Bt601, R::Limited, true},
+        {V4L2_COLORSPACE_REC709, V4L2_YCBCR_ENC_DEFAULT, V4L2_QUANTIZATION_DEFAULT, M::Bt709, R::Limited, true},
+        {V4L2_COLORSPACE_JPEG, V4L2_YCBCR_ENC_DEFAULT, V4L2_QUANTIZATION_DEFAULT, M::Bt601, R::Full, true},
+        {V4L2_COLORSPACE_SRGB, V4L2_YCBCR_ENC_709, V4L2_QUANTIZATION_FULL_RANGE, M::Bt709, R::Full, true},
+        {V4L2_COLORSPACE_REC709, V4L2_YCBCR_ENC_601, V4L2_QUANTIZATION_LIM_RANGE, M::Bt601, R::Limited, true},
+        {V4L2_COLORSPACE_BT2020, V4L2_YCBCR_ENC_DEFAULT, V4L2_QUANTIZATION_DEFAULT, M::Bt601, R::Limited, false},
+    };
+    for (const Case& c : cases) {
+        const v4l2::YuvEncoding e = v4l2::yuvEncoding(c.colorspace, c.ycbcr, c.quantization);
+        EXPECT_EQ(e.matrix, c.matrix) << c.colorspace << " " << c.ycbcr << " " << c.quantization;
+        EXPECT_EQ(e.range, c.range) << c.colorspace << " " << c.ycbcr << " " << c.quantization;
+        EXPECT_EQ(e.supported, c.supported) << c.colorspace << " " << c.ycbcr << " " << c.quantization;
+    }
+    // The planes carry it: BT.709 full range makes other colours of the same bytes.
+    const Bytes yuyv = {16, 128, 235, 128, 81, 90, 81, 240, 41, 240, 41, 110, 145, 54, 145, 34};
+    v4l2::PixelLayout layout{V4L2_PIX_FMT_YUYV, 4, 2, 0};
+    const std::optional<YuvImage> sd = v4l2::capturedYuv(yuyv, layout);
+    layout.matrix = M::Bt709;
+    layout.range = R::Full;
+    const std::optional<YuvImage> hd = v4l2::capturedYuv(yuyv, layout);
+    ASSERT_TRUE(sd && hd);
+    EXPECT_EQ(hd->matrix, M::Bt709);
+    EXPECT_EQ(hd->range, R::Full);
+    EXPECT_GT(cv::norm(yuvToBgr(*hd), yuvToBgr(*sd), cv::NORM_INF), 10.0);
+}
+
 TEST(V4l2Formats, Nv12)
 {
     // 4x2 pixels, stride 6: the Y rows, then one row of interleaved Cb,Cr for the two 2x2 blocks.
