@@ -66,11 +66,10 @@ struct Frame {
     double depthScale = 0.0;
     /// Colour as a camera captured it, from a Source with SourceSettings::yuvColor where the
     /// camera sends Y'CbCr (YUYV, NV12): its planes, owned by the frame, for Filter::process to
-    /// upload as they are; `color` is then empty. Otherwise its planes are empty. colorBgr()
-    /// gives BGR either way.
+    /// upload as they are (Filter::process(const Frame&) takes either); `color` is then empty.
+    /// Otherwise its planes are empty. colorBgr() gives BGR either way.
     YuvImage yuv = {};
 };
-
 
 /// `frame.depth` as CV_32FC1 metres: 16-bit depth divided by its depthScale (0 stays 0), metres
 /// as they are (the same pixels, not a copy), empty as it is.

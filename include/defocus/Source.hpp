@@ -2,7 +2,7 @@
 // defocus::Source: the command line's inputs as a stream of colour + depth frames, for programs
 // that want to read what `defocus INPUT` reads (GStreamer's defocussrc is one).
 //   defocus::Source source({"data/tum_fr1_rpy"});        // TUM folder: depth in metres, 5000 units/m
-//   while (auto frame = source.next()) filter.process(frame->color, frame->depth, frame->timestampS);
+//   while (auto frame = source.next()) filter.process(*frame);
 //
 // Inputs, as the command line takes them: a TUM RGB-D folder (rgb.txt + depth.txt, files named by
 // timestamp), a folder of colour images with `depth` a folder (paired by sorted name) or one file,
