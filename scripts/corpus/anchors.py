@@ -24,20 +24,11 @@ os.environ["OPENCV_IO_ENABLE_OPENEXR"] = "1"
 import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
+from corpusdirs import scene_dirs  # noqa: E402  (this folder)
 from thinlens import coc_px  # noqa: E402  (this folder: the filter's thin-lens CoC)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TOOLS = ["gegl", "blender"]
-
-
-def scene_dirs(path):
-    if os.path.isfile(os.path.join(path, "scene.json")):
-        return [path]
-    found = sorted(os.path.join(path, d) for d in os.listdir(path)
-                   if os.path.isfile(os.path.join(path, d, "scene.json")))
-    if not found:
-        sys.exit(f"anchors.py: {path}: no scene.json in it or its subfolders")
-    return found
 
 
 def depth_metres(scene_dir, meta):
@@ -60,7 +51,7 @@ def main():
     args = parser.parse_args()
     tools = args.tool or TOOLS
     for path in args.paths:
-        for scene_dir in scene_dirs(path):
+        for scene_dir in scene_dirs(path, "anchors.py"):
             name = os.path.basename(os.path.normpath(scene_dir))
             meta = json.load(open(os.path.join(scene_dir, "scene.json")))
             if meta["lens"].get("fieldOfView") != "focal-length":

@@ -21,17 +21,7 @@ import sys
 os.environ["OPENCV_IO_ENABLE_OPENEXR"] = "1"
 import cv2  # noqa: E402
 
-
-def scene_dirs(path):
-    if not os.path.isdir(path):
-        sys.exit(f"turn.py: error: {path} is not a folder")
-    if os.path.isfile(os.path.join(path, "scene.json")):
-        return [path]
-    found = sorted(os.path.join(path, name) for name in os.listdir(path)
-                   if os.path.isfile(os.path.join(path, name, "scene.json")))
-    if not found:
-        sys.exit(f"turn.py: error: {path} is neither a scene folder (scene.json) nor a corpus of them")
-    return found
+from corpusdirs import scene_dirs  # noqa: E402  (this folder)
 
 
 def turned_rotation(degrees, blades):
@@ -81,7 +71,7 @@ def main():
     parser.add_argument("--out", default="out/corpus-turned", help="folder for the turned scenes (default %(default)s)")
     parser.add_argument("dirs", nargs="+", metavar="CORPUS_OR_SCENE_DIR")
     args = parser.parse_args()
-    scenes = [d for path in args.dirs for d in scene_dirs(path)]
+    scenes = [d for path in args.dirs for d in scene_dirs(path, "turn.py")]
     if os.path.exists(args.out):
         shutil.rmtree(args.out)
     written = sum(turn(d, args.out) for d in scenes)
