@@ -3,7 +3,6 @@
 #include "bench/BenchThroughput.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <ctime>
 #include <optional>
@@ -15,6 +14,7 @@
 #include "defocus/Source.hpp"
 #include "samples/BenchMachine.hpp"
 #include "samples/ExitStatus.hpp"
+#include "tests/YuvPlanes.hpp"
 
 namespace defocus {
 namespace {
@@ -28,41 +28,13 @@ double threadCpuMs()
     return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
-/// `bgr` (even width and height) as planes of `layout` (OpenCV's BT.601 I420, limited range;
-/// NV12 its chroma interleaved; YUYV each pair's Cb and Cr from its 2x2 block's).
-YuvImage yuvOf(const cv::Mat& bgr, YuvImage::Layout layout)
-{
-    cv::Mat packed;
-    cv::cvtColor(bgr, packed, cv::COLOR_BGR2YUV_I420);
-    const int w = bgr.cols, h = bgr.rows;
-    YuvImage yuv;
-    yuv.matrix = YuvImage::Matrix::Bt601;
-    yuv.y = packed.rowRange(0, h);
-    yuv.u = cv::Mat(h / 2, w / 2, CV_8UC1, packed.ptr(h));
-    yuv.v = cv::Mat(h / 2, w / 2, CV_8UC1, packed.ptr(h) + (w / 2) * (h / 2));
-    if (layout == YuvImage::Layout::Nv12) {
-        cv::Mat chroma;
-        cv::merge(std::vector<cv::Mat>{yuv.u, yuv.v}, chroma);
-        yuv = {YuvImage::Layout::Nv12, yuv.matrix, yuv.range, yuv.y, chroma, {}};
-    } else if (layout == YuvImage::Layout::Yuyv) {
-        cv::Mat pairs(h, w, CV_8UC2);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x)
-                pairs.at<cv::Vec2b>(y, x) = {yuv.y.at<std::uint8_t>(y, x),
-                                             (x % 2 == 0 ? yuv.u : yuv.v).at<std::uint8_t>(y / 2, x / 2)};
-        yuv = {YuvImage::Layout::Yuyv, yuv.matrix, yuv.range, pairs, {}, {}};
-    }
-    return yuv;
-}
-
 /// --versus-yuv: the table of Y'CbCr in flight against BGR in flight, per size.
 int runVersusYuv(const ThroughputOptions& options, const std::vector<Frame>& clip, Filter& filter)
 {
     const YuvImage::Layout layout = options.versusYuv == "yuyv"   ? YuvImage::Layout::Yuyv
                                     : options.versusYuv == "nv12" ? YuvImage::Layout::Nv12
                                                                   : YuvImage::Layout::I420;
-    std::string name = options.versusYuv;
-    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+    const std::string name = test::layoutName(layout);
     fmt::print("{:>11} | {:>22} | {:>22} | {:>9} | {:>9}\n", "size", "BGR ms (fps)", name + " ms (fps)",
                name + "/BGR", "CPU ms");
     int status = kExitDone;
@@ -73,7 +45,7 @@ int runVersusYuv(const ThroughputOptions& options, const std::vector<Frame>& cli
             cv::Mat color, d;
             cv::resize(f.color, color, size, 0, 0, cv::INTER_AREA);
             cv::resize(f.depth, d, size, 0, 0, cv::INTER_NEAREST);
-            yuv.push_back(yuvOf(color, layout));
+            yuv.push_back(test::opencvYuv(color, layout)); // OpenCV's BT.601 limited range
             bgr.push_back(yuvToBgr(yuv.back())); // what the filter makes of the planes: the same frames
             depth.push_back(d);
         }

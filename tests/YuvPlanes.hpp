@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Y'CbCr test frames made by OpenCV, as planes (defocus::YuvImage) and packed one plane after the
 // other as GStreamer's I420, NV12 and YUY2 buffers and OpenCV's cvtColor hold them (the tests of
-// the public API and of the GStreamer element include it beside the installed headers).
+// the public API and of the GStreamer element include it beside the installed headers, and
+// defocus-bench throughput --versus-yuv makes its frames with it).
 #pragma once
 
 #include <vector>
