@@ -461,12 +461,10 @@ bool V4l2Source::dequeue(std::optional<Frame>& frame)
         const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(mapped.start), used);
         if (layout_.fourcc != V4L2_PIX_FMT_MJPEG && used < v4l2::minimumFrameBytes(layout_))
             problem = fmt::format("{} bytes, a frame needs {}", used, v4l2::minimumFrameBytes(layout_));
-        else if (options_.yuvColor && options_.role == V4l2Options::Role::Color &&
-                 (yuv = v4l2::capturedYuv(bytes, layout_)))
-            image = yuv->y;
-        else
+        else if (!(options_.yuvColor && options_.role == V4l2Options::Role::Color &&
+                   (yuv = v4l2::capturedYuv(bytes, layout_))))
             image = v4l2::convert(bytes, layout_);
-        if (image.empty() && problem.empty())
+        if (!yuv && image.empty() && problem.empty())
             problem = fmt::format("its {} data do not decode", v4l2::fourccName(layout_.fourcc));
     }
     // The converted image (or the copied planes) owns its pixels, so the buffer goes back to the
@@ -478,7 +476,7 @@ bool V4l2Source::dequeue(std::optional<Frame>& frame)
         throw SourceError(fmt::format("camera {}: VIDIOC_QBUF failed after {} frames: {}", dev,
                                       delivered_, errorText(error)));
     }
-    if (image.empty()) {
+    if (!yuv && image.empty()) {
         ++dropped_;
         if (warnings_++ < 5)
             logger().warn("camera {}: skipped frame {}: {}", dev, buffer.sequence, problem);
