@@ -230,7 +230,8 @@ struct FrameContext {
     gl::Texture depthAsGiven; ///< the frame's depth as it came (prepareOnGpu)
     gl::Texture depth;        ///< filled, the frame's size
     gl::Framebuffer depthTarget; ///< `depth`'s (DepthPrepPass writes it)
-    gl::StorageBuffer measurementBuffer; ///< SceneMeasurePass's, until read
+    gl::StorageBuffer measurementBuffer; ///< SceneMeasurePass's
+    gl::ReadbackBuffer measurementBack;  ///< the measurement on its way back, until read
     bool measuring = false;   ///< the GPU's measurement is submitted and not yet read
     bool hasDepth = false;    ///< the frame came with depth (the GPU's measurement counts its holes)
     SceneMeasurement measurement;
@@ -614,7 +615,8 @@ void Pipeline::Impl::prepare(FrameContext& f)
             case PassKind::SceneMeasure:
                 f.cocParams.set(f.coefficients, f.quality.targetFormat == TargetFormat::Rgba16F);
                 sceneMeasurePass.run(f.depth, srgbInput ? f.colorBytes : f.colorTexture, srgbInput, f.cocParams,
-                                     f.hasDepth ? &depthPrepPass.measured() : nullptr, f.measurementBuffer);
+                                     f.hasDepth ? &depthPrepPass.measured() : nullptr, f.measurementBuffer,
+                                     f.measurementBack);
                 break;
             default: CV_Error(cv::Error::StsInternal, std::string(node.name) + " is not a pass that prepares a frame");
             }
@@ -654,7 +656,7 @@ void Pipeline::Impl::planFrame()
         prepare(f);
     if (f.measuring) {
         std::size_t invalidPixels = 0;
-        f.measurement = SceneMeasurePass::read(f.measurementBuffer, f.size, f.hasDepth, invalidPixels);
+        f.measurement = SceneMeasurePass::read(f.measurementBack, f.size, f.hasDepth, invalidPixels);
         f.invalidFraction = static_cast<double>(invalidPixels) / static_cast<double>(f.size.area());
         f.measuring = false;
     }

@@ -188,12 +188,6 @@ void StorageBuffer::bind(GLuint binding) const
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, id());
 }
 
-void StorageBuffer::read(void* data, GLsizeiptr bytes) const
-{
-    assert(bytes <= size_);
-    glGetNamedBufferSubData(id(), 0, bytes, data);
-}
-
 ReadbackBuffer::ReadbackBuffer(GLsizeiptr size, std::string_view name) : size_(size)
 {
     GLuint id = 0;
@@ -240,6 +234,15 @@ void ReadbackBuffer::readPixels(GLuint framebuffer, int width, int height, GLenu
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     fence_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glFlush(); // the read starts now, not when the next frame's commands push it out
+}
+
+void ReadbackBuffer::readBuffer(GLuint source, GLsizeiptr bytes)
+{
+    assert(bytes <= size_);
+    dropFence();
+    glCopyNamedBufferSubData(source, handle_.id(), 0, 0, bytes);
+    fence_ = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush();
 }
 
 void ReadbackBuffer::copyTo(void* data, GLsizeiptr bytes)

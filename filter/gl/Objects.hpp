@@ -169,8 +169,6 @@ public:
     /// Replaces the first `bytes`.
     void update(const void* data, GLsizeiptr bytes);
     void bind(GLuint binding) const;
-    /// Copies `bytes` from the start into `data`; waits for the GPU's writes to finish.
-    void read(void* data, GLsizeiptr bytes) const;
     GLuint id() const { return handle_.id(); }
 
 private:
@@ -178,9 +176,10 @@ private:
     GLsizeiptr size_ = 0;
 };
 
-/// A pixel pack buffer that glReadPixels fills behind a fence: the read is queued with the
-/// frame's passes and returns at once; copyTo() waits for the fence (not for the whole GPU) and
-/// copies the pixels out.
+/// A buffer that glReadPixels or a buffer copy fills behind a fence: the read is queued with the
+/// frame's passes and returns at once; copyTo() waits for the fence (for the commands queued
+/// before the read, not for those queued after it, as glGetBufferSubData may) and copies the
+/// bytes out.
 class ReadbackBuffer {
 public:
     ReadbackBuffer() = default;
@@ -196,7 +195,10 @@ public:
     /// `format`/`type`, rows packed with no padding, and fences it. Needs width * height * pixel
     /// size <= size().
     void readPixels(GLuint framebuffer, int width, int height, GLenum format, GLenum type);
-    /// Waits for the last readPixels() and copies its first `bytes` into `data`.
+    /// Queues a copy of the first `bytes` of buffer `source` (written by shaders before a
+    /// glMemoryBarrier with GL_BUFFER_UPDATE_BARRIER_BIT) and fences it. Needs bytes <= size().
+    void readBuffer(GLuint source, GLsizeiptr bytes);
+    /// Waits for the last readPixels() or readBuffer() and copies its first `bytes` into `data`.
     void copyTo(void* data, GLsizeiptr bytes);
 
 private:

@@ -49,7 +49,8 @@ SceneMeasurePass::SceneMeasurePass()
 }
 
 void SceneMeasurePass::run(const gl::Texture& depth, const gl::Texture& color, bool eightBit,
-                           const CocParams& params, const gl::Texture* measured, gl::StorageBuffer& out)
+                           const CocParams& params, const gl::Texture* measured, gl::StorageBuffer& out,
+                           gl::ReadbackBuffer& back)
 {
     const cv::Size tiles = tilesOf({depth.width(), depth.height()});
     const auto bytes = static_cast<GLsizeiptr>(sizeof(Header) + tiles.area() * sizeof(Tile));
@@ -68,15 +69,18 @@ void SceneMeasurePass::run(const gl::Texture& depth, const gl::Texture& color, b
     out.bind(0);
     glDispatchCompute(static_cast<GLuint>(tiles.width), static_cast<GLuint>(tiles.height), 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    if (back.size() < bytes)
+        back = gl::ReadbackBuffer(bytes, "scene measurement read");
+    back.readBuffer(out.id(), bytes);
 }
 
-SceneMeasurement SceneMeasurePass::read(const gl::StorageBuffer& buffer, cv::Size frame, bool countedHoles,
+SceneMeasurement SceneMeasurePass::read(gl::ReadbackBuffer& back, cv::Size frame, bool countedHoles,
                                         std::size_t& invalidPixels)
 {
     const cv::Size grid = tilesOf(frame);
     // The header and the tiles in one read (one wait for the GPU), as the shader lays them out.
     std::vector<Tile> words(sizeof(Header) / sizeof(Tile) + static_cast<std::size_t>(grid.area()));
-    buffer.read(words.data(), static_cast<GLsizeiptr>(sizeof(Header) + grid.area() * sizeof(Tile)));
+    back.copyTo(words.data(), static_cast<GLsizeiptr>(sizeof(Header) + grid.area() * sizeof(Tile)));
     Header header{};
     std::memcpy(&header, words.data(), sizeof header);
     const Tile* tiles = words.data() + sizeof(Header) / sizeof(Tile);
