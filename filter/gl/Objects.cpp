@@ -2,12 +2,14 @@
 // RAII GL object wrappers: creation with DSA (GL 4.5), deletion, debug labels.
 #include "filter/gl/Objects.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cstring>
 #include <stdexcept>
 #include <utility>
 
 #include <fmt/format.h>
+#include <opencv2/core/utility.hpp>
 
 namespace defocus::gl {
 
@@ -24,6 +26,24 @@ void waitAndDelete(GLsync& fence)
     glDeleteSync(fence);
     fence = nullptr;
 }
+void copyFrameBytes(void* to, const void* from, std::size_t bytes)
+{
+    // Stripes of 1 MiB: below two of them, the threads' start costs more than they save.
+    constexpr std::size_t kStripe = std::size_t{1} << 20;
+    if (bytes < 2 * kStripe) {
+        std::memcpy(to, from, bytes);
+        return;
+    }
+    auto* out = static_cast<unsigned char*>(to);
+    const auto* in = static_cast<const unsigned char*>(from);
+    const auto stripes = static_cast<int>((bytes + kStripe - 1) / kStripe);
+    cv::parallel_for_(cv::Range(0, stripes), [&](const cv::Range& range) {
+        const std::size_t begin = static_cast<std::size_t>(range.start) * kStripe;
+        const std::size_t end = std::min(bytes, static_cast<std::size_t>(range.end) * kStripe);
+        std::memcpy(out + begin, in + begin, end - begin);
+    });
+}
+
 void deleteFramebuffer(GLuint id) { glDeleteFramebuffers(1, &id); }
 void deleteBuffer(GLuint id) { glDeleteBuffers(1, &id); }
 void deleteVertexArray(GLuint id) { glDeleteVertexArrays(1, &id); }
@@ -252,7 +272,7 @@ void ReadbackBuffer::copyTo(void* data, GLsizeiptr bytes)
     const void* mapped = glMapNamedBufferRange(handle_.id(), 0, bytes, GL_MAP_READ_BIT);
     if (mapped == nullptr)
         throw std::runtime_error("glMapNamedBufferRange failed on a readback buffer");
-    std::memcpy(data, mapped, static_cast<std::size_t>(bytes));
+    copyFrameBytes(data, mapped, static_cast<std::size_t>(bytes));
     glUnmapNamedBuffer(handle_.id());
 }
 

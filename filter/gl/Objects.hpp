@@ -64,6 +64,11 @@ void deleteProgram(GLuint id);
 /// it; nothing for a null fence.
 void waitAndDelete(GLsync& fence);
 
+/// memcpy() of a frame's bytes to or from a mapped buffer, in stripes on OpenCV's threads where
+/// it is large enough to pay for them: one core's memcpy does not reach the memory's bandwidth,
+/// and the calling thread does only its share (a 1080p frame's is ~10 MB to go up, 6 to come back).
+void copyFrameBytes(void* to, const void* from, std::size_t bytes);
+
 /// Labels an object for GL debuggers and driver messages (no-op without GL_KHR_debug).
 void label(GLenum identifier, GLuint id, std::string_view name);
 

@@ -2,7 +2,6 @@
 // Texture uploads through persistently mapped pixel unpack buffers, fenced per slot.
 #include "filter/gl/UploadRing.hpp"
 
-#include <cstring>
 #include <stdexcept>
 
 namespace defocus::gl {
@@ -34,7 +33,7 @@ void UploadRing::upload(const Texture& texture, GLenum format, GLenum type, cons
         slot.size = bytes;
         label(GL_BUFFER, id, name_);
     }
-    std::memcpy(slot.mapped, data, bytes);
+    copyFrameBytes(slot.mapped, data, bytes);
     glBindBuffer(GL_PIXEL_UNPACK_BUFFER, slot.buffer.id());
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTextureSubImage2D(texture.id(), 0, 0, 0, texture.width(), texture.height(), format, type, nullptr);
