@@ -276,6 +276,32 @@ TEST_F(Library, ContactSheetLeavesTheFrameAsItWas)
     EXPECT_TRUE(identical(plain.process(nextColor, nextDepth), afterSheet));
 }
 
+// Defects caught: an image the caller still holds filled again with a later frame (its memory
+// reused without asking whether anyone else holds it); an image let go of not reused, each
+// frame a new allocation whose pages the copy faults in.
+TEST_F(Library, ImagesStayAsReturnedWhileHeldAndAreFilledAgainOnceLetGo)
+{
+    const cv::Mat first = filter_->process(color_, depth_);
+    ASSERT_FALSE(filter_->lastFrame().plan.allInFocus);
+    const cv::Mat firstAsReturned = first.clone();
+    defocus::Settings farther = settings_;
+    farther.lens.focusM = 2.0;
+    filter_->setSettings(farther);
+    cv::Mat second = filter_->process(color_, depth_);
+    ASSERT_FALSE(filter_->lastFrame().plan.allInFocus);
+    EXPECT_TRUE(identical(first, firstAsReturned)) << "the first image changed under its holder";
+    EXPECT_FALSE(identical(first, second));
+    EXPECT_NE(first.data, second.data);
+
+    const cv::Mat secondAsReturned = second.clone();
+    const unsigned char* secondMemory = second.data;
+    second.release();
+    const cv::Mat third = filter_->process(color_, depth_);
+    EXPECT_EQ(third.data, secondMemory) << "the memory let go of was not filled again";
+    EXPECT_TRUE(identical(third, secondAsReturned));
+    EXPECT_TRUE(identical(first, firstAsReturned));
+}
+
 // Defect caught: the last frame's GPU times lost at the end of a stream (finishGpuTimings() not
 // waiting for them), or put to another frame than the one they measured.
 TEST_F(Library, LastFramesGpuTimesAtTheEnd)
