@@ -953,8 +953,10 @@ int imageType(Encoding encoding)
 }
 
 /// A frame all in focus as `encoding` asks: 8-bit input bit-exact (BGRx's fourth byte made 255),
-/// float input from `linear`, its cleaned-up copy.
-cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encoding)
+/// float input from `linear`, its cleaned-up copy. 8-bit input as 8-bit output goes into `out`
+/// (of the colour's size and imageType(encoding); empty otherwise); `owned`: `color` is the
+/// pipeline's own (the conversion of Y'CbCr), returned as it is where it needs no change.
+cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encoding, bool owned, cv::Mat out)
 {
     if (color.depth() != CV_8U) {
         if (encoding == Encoding::Linear32F)
@@ -965,23 +967,30 @@ cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encodi
         cv::cvtColor(srgb, bgra, cv::COLOR_BGR2BGRA);
         return bgra;
     }
-    cv::Mat out;
     if (encoding == Encoding::Srgb8Bgra) {
         if (color.channels() == 3) {
             cv::cvtColor(color, out, cv::COLOR_BGR2BGRA);
         } else {
-            out = color.clone();
+            gl::copyFrameBytes(out.data, color.data, color.total() * color.elemSize());
             const int toAlpha[] = {0, 3};
             const cv::Mat opaque(color.size(), CV_8UC1, cv::Scalar(255));
             cv::mixChannels(&opaque, 1, &out, 1, toAlpha, 1);
         }
         return out;
     }
+    if (encoding == Encoding::Linear32F) {
+        cv::Mat bgr = color;
+        if (color.channels() == 4)
+            cv::cvtColor(color, bgr, cv::COLOR_BGRA2BGR);
+        return decodeSrgb(bgr);
+    }
     if (color.channels() == 4)
         cv::cvtColor(color, out, cv::COLOR_BGRA2BGR);
+    else if (owned)
+        return color;
     else
-        out = color.clone();
-    return encoding == Encoding::Srgb8 ? out : decodeSrgb(out);
+        gl::copyFrameBytes(out.data, color.data, color.total() * color.elemSize());
+    return out;
 }
 
 } // namespace
@@ -1030,11 +1039,15 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
         // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
         // CoC pass's clean-up (no NaN, no negatives, within the target's range).
         // Y'CbCr: the bytes the GPU would have made of it.
-        const cv::Mat color = p.current.color.empty() ? convertYuv(p.current.yuv) : p.current.color;
+        const bool owned = p.current.color.empty();
+        const cv::Mat color = owned ? convertYuv(p.current.yuv) : p.current.color;
         const bool srgbInput = color.depth() == CV_8U;
         const bool half = p.current.quality.targetFormat == TargetFormat::Rgba16F;
         const cv::Mat linear = srgbInput ? cv::Mat() : sanitizeLinear(color, CocParams::largestColor(half));
-        read.ready = passThrough(color, linear, encoding);
+        // Into an image of the pool, as a read from the GPU goes.
+        const bool pooled = srgbInput && encoding != Encoding::Linear32F && !owned;
+        read.ready = passThrough(color, linear, encoding, owned,
+                                 pooled ? p.takeOutput(p.size, imageType(encoding)) : cv::Mat());
         p.current.timings.readbackMs = msSince(start);
         p.current.timings.totalMs = p.current.spentMs();
         read.timings = p.current.timings;

@@ -300,6 +300,16 @@ TEST_F(Library, ImagesStayAsReturnedWhileHeldAndAreFilledAgainOnceLetGo)
     EXPECT_EQ(third.data, secondMemory) << "the memory let go of was not filled again";
     EXPECT_TRUE(identical(third, secondAsReturned));
     EXPECT_TRUE(identical(first, firstAsReturned));
+
+    // A frame all in focus is returned from the same images, as it came in.
+    filter_->setSettings(settings_);
+    const cv::Mat flat(depth_.size(), CV_32F, cv::Scalar(1.0f));
+    const cv::Mat inFocus = filter_->process(color_, flat);
+    ASSERT_TRUE(filter_->lastFrame().plan.allInFocus);
+    EXPECT_TRUE(identical(inFocus, color_));
+    EXPECT_NE(inFocus.data, color_.data) << "the caller's own image returned";
+    EXPECT_TRUE(identical(first, firstAsReturned));
+    EXPECT_TRUE(identical(third, secondAsReturned));
 }
 
 // Defect caught: the last frame's GPU times lost at the end of a stream (finishGpuTimings() not
