@@ -67,6 +67,9 @@ struct Options : cli::QualityNames {
     double fNumber = 2.0;
     double focalLengthMm = 50.0;
     double maxCocAt640 = 32.0;
+    int blades = 6; ///< LensSettings::blades, bladeRotationDeg, apertureRatio
+    double bladeRotationDeg = 0.0;
+    double apertureRatio = 1.0;
     bool noTimers = false;
     bool noAdaptive = false;
     bool finishEachPass = false;
@@ -428,6 +431,9 @@ int run(const Options& options, const std::string& commandLine)
     baseLens.focusM = options.focusM;
     baseLens.fNumber = options.fNumber;
     baseLens.focalLengthMm = options.focalLengthMm;
+    baseLens.blades = options.blades;
+    baseLens.bladeRotationDeg = options.bladeRotationDeg;
+    baseLens.apertureRatio = options.apertureRatio;
     {
         auto issues = validate(quality);
         for (const cv::Size size : sizes) {
@@ -491,8 +497,11 @@ int run(const Options& options, const std::string& commandLine)
     fmt::print("passes: {} shaders{}\n",
                options.versusFragment || gl::computePasses(info.glRenderer) ? "compute" : "fragment",
                options.versusFragment ? "" : " (the renderer's; DEFOCUS_PASSES=compute or fragment chooses)");
-    fmt::print("lens: thin lens {} mm f/{} focused at {} m, 36 mm sensor, max-coc {} px per 640 px of width\n",
-               options.focalLengthMm, options.fNumber, options.focusM, options.maxCocAt640);
+    fmt::print("lens: thin lens {} mm f/{} focused at {} m, 36 mm sensor, max-coc {} px per 640 px of width; "
+               "aperture: {}, rotated {} deg, ratio {}\n",
+               options.focalLengthMm, options.fNumber, options.focusM, options.maxCocAt640,
+               options.blades == 0 ? std::string("circle") : fmt::format("{} blades", options.blades),
+               options.bladeRotationDeg, options.apertureRatio);
     if (options.versusHalfOnly)
         fmt::print("versus: the defocused scene also always at half size (no quarter size on large blur: the path "
                    "before it), in a second pipeline, frames alternating between the two\n");
@@ -599,7 +608,10 @@ int run(const Options& options, const std::string& commandLine)
               {"fNumber", options.fNumber},
               {"focalLengthMm", options.focalLengthMm},
               {"sensorWidthMm", baseLens.sensorWidthMm},
-              {"maxCocPxPer640", options.maxCocAt640}}},
+              {"maxCocPxPer640", options.maxCocAt640},
+              {"blades", options.blades},
+              {"bladeRotationDeg", options.bladeRotationDeg},
+              {"apertureRatio", options.apertureRatio}}},
             {"results", results}};
         std::ofstream file(options.json);
         file << document.dump(2) << '\n';
@@ -948,6 +960,12 @@ int main(int argc, char** argv)
     app.add_option("--f-number", o.fNumber, "Aperture as an f-number")->capture_default_str();
     app.add_option("--focal-length", o.focalLengthMm, "Focal length, millimetres")->capture_default_str();
     app.add_option("--max-coc", o.maxCocAt640, "Largest blur diameter in pixels at 640 px wide; scaled by width/640")
+        ->capture_default_str();
+    app.add_option("--blades", o.blades, "Aperture blades: 0 = a circular aperture, else the polygon's corners, 3 to 16")
+        ->capture_default_str();
+    app.add_option("--blade-rotation", o.bladeRotationDeg, "Aperture rotation, degrees counter-clockwise (as defocus)")
+        ->capture_default_str();
+    app.add_option("--aperture-ratio", o.apertureRatio, "Anamorphic squeeze of the aperture (as defocus)")
         ->capture_default_str();
     app.add_flag("--no-adaptive", o.noAdaptive,
                  "Run every pass on every pixel (no skipping of in-focus frames and tiles), for comparison");
