@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// Bokeh sprites: one compute dispatch appends the sprites and counts them into the indirect draw
-// command in the same buffer, a second of one invocation empties the draw of a frame over its
-// budget, the CPU puts them in the order of their pixels; one instanced draw of hexagons adds
-// them, blended, to the output.
+// Bokeh sprites: three compute dispatches mark the pixels that make a sprite per tile, count
+// them into the indirect draw command in the same buffer (empty for a frame over its budget) and
+// write them in the order of their tiles and pixels; one instanced draw of hexagons adds them,
+// blended, to the output. Nothing comes back to the CPU.
 #include "filter/passes/HighlightSpritePass.hpp"
 
 #include <algorithm>
@@ -26,6 +26,8 @@ namespace {
 // instances), the capacity, padding, then two vec4 per sprite.
 constexpr std::size_t kHeaderBytes = 8 * sizeof(std::uint32_t);
 constexpr std::size_t kSpriteBytes = 8 * sizeof(float);
+// Per tile searched (highlight_sprites.comp's TileSprites): its first sprite, 256 bits of pixels.
+constexpr std::size_t kTileBytes = 9 * sizeof(std::uint32_t);
 
 /// Mirrors the std140 block SpriteParams in aperture_sprite.glsl.
 struct SpriteParams {
@@ -46,8 +48,9 @@ static_assert(offsetof(SpriteParams, fanCorner) == 32 && offsetof(SpriteParams, 
 } // namespace
 
 HighlightSpritePass::HighlightSpritePass()
-    : find_(gl::Program::compute("highlight_sprites.comp", "highlight sprites: find")),
+    : count_(gl::Program::compute("highlight_sprites.comp", "highlight sprites: count", {"COUNT 1"})),
       settle_(gl::Program::compute("highlight_sprites.comp", "highlight sprites: settle", {"SETTLE 1"})),
+      emit_(gl::Program::compute("highlight_sprites.comp", "highlight sprites: emit")),
       draw_("highlight_sprite.vert", "highlight_sprite.frag", "highlight sprites: draw"),
       spriteParams_(sizeof(SpriteParams), "highlight sprites params"),
       sprites_(static_cast<GLsizeiptr>(kHeaderBytes + kSpriteBytes), "highlight sprites"),
@@ -116,31 +119,22 @@ void HighlightSpritePass::find(const gl::Texture& color, const gl::Texture& dept
                                        "highlight sprites: tiles searched");
         tiles_.update(tiles.data(), bytes);
         tiles_.bind(3);
-        find_.use();
+        const auto tileBytes = static_cast<GLsizeiptr>(tiles.size() * kTileBytes);
+        if (tileSprites_.size() < tileBytes)
+            tileSprites_ = gl::StorageBuffer(static_cast<GLsizeiptr>(std::bit_ceil(static_cast<std::size_t>(tileBytes))),
+                                             "highlight sprites: per tile");
+        tileSprites_.bind(4);
+        count_.use();
         glDispatchCompute(static_cast<GLuint>(tiles.size()), 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        settle_.use();
+        glUniform1ui(0, static_cast<GLuint>(tiles.size()));
+        glDispatchCompute(1, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        emit_.use();
+        glDispatchCompute(static_cast<GLuint>(tiles.size()), 1, 1);
     }
-    settle_.use();
-    glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-
-    // The search appends sprites in whatever order its invocations run, and the draw adds them
-    // in that order: where sprites overlap, float sums (and an sRGB8 target's rounding after each
-    // one) then differed from run to run by an 8-bit step. In the order of their pixels the same
-    // frame gives the same bits every time (AdaptivePlanGLTest). Each sprite is one texel, so
-    // its position orders it.
-    std::array<std::uint32_t, 8> read{};
-    glGetNamedBufferSubData(sprites_.id(), 0, static_cast<GLsizeiptr>(sizeof read), read.data());
-    const std::size_t count = read[1] / 4; // four instances per sprite
-    if (count > 1) {
-        std::vector<std::array<float, 8>> list(count);
-        const auto bytes = static_cast<GLsizeiptr>(count * kSpriteBytes);
-        glGetNamedBufferSubData(sprites_.id(), static_cast<GLintptr>(kHeaderBytes), bytes, list.data());
-        std::sort(list.begin(), list.end(), [](const std::array<float, 8>& a, const std::array<float, 8>& b) {
-            return a[1] < b[1] || (a[1] == b[1] && a[0] < b[0]);
-        });
-        glNamedBufferSubData(sprites_.id(), static_cast<GLintptr>(kHeaderBytes), bytes, list.data());
-    }
 }
 
 void HighlightSpritePass::draw(const CocParams& params, const gl::Texture& depth, const gl::Framebuffer& target)

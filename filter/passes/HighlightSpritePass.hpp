@@ -2,7 +2,8 @@
 // Bokeh sprites for highlights: the light of blurred pixels brighter than a threshold, which the
 // CoC pass takes out of the gather, scattered in the aperture's shape with exact edges and added to
 // the output. Runs only on frames with highlights. Shaders: highlight_sprites.comp (find them, on the
-// GPU, into an indirect draw), highlight_sprite.vert/.frag (draw them).
+// GPU, into an indirect draw, in an order that does not depend on the GPU's), highlight_sprite.vert/.frag
+// (draw them).
 #pragma once
 
 #include <cstddef>
@@ -56,10 +57,11 @@ private:
     /// Fills the SpriteParams block (aperture_sprite.glsl) for a frame of `depth`'s size.
     void updateSpriteParams(const gl::Texture& depth, const ApertureShape& shape, bool nearField);
 
-    gl::Program find_, settle_, draw_;
+    gl::Program count_, settle_, emit_, draw_;
     gl::UniformBuffer spriteParams_;
     gl::StorageBuffer sprites_;
     gl::StorageBuffer tiles_; ///< the tiles searched, (column, row) as two ints each
+    gl::StorageBuffer tileSprites_; ///< per tile searched: its first sprite, its pixels that make one
     std::size_t capacity_ = 0; ///< sprites the buffer holds
     gl::Sampler nearest_;
 };
