@@ -952,6 +952,16 @@ int imageType(Encoding encoding)
     return CV_8UC3;
 }
 
+/// `from` into `to`, of its size and type: in stripes on OpenCV's threads where both are one
+/// block of memory.
+void copyImage(const cv::Mat& from, cv::Mat& to)
+{
+    if (from.isContinuous() && to.isContinuous())
+        gl::copyFrameBytes(to.data, from.data, from.total() * from.elemSize());
+    else
+        from.copyTo(to);
+}
+
 /// A frame all in focus as `encoding` asks: 8-bit input bit-exact (BGRx's fourth byte made 255),
 /// float input from `linear`, its cleaned-up copy. 8-bit input as 8-bit output goes into `out`
 /// (of the colour's size and imageType(encoding); empty otherwise); `owned`: `color` is the
@@ -971,7 +981,7 @@ cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encodi
         if (color.channels() == 3) {
             cv::cvtColor(color, out, cv::COLOR_BGR2BGRA);
         } else {
-            gl::copyFrameBytes(out.data, color.data, color.total() * color.elemSize());
+            copyImage(color, out);
             const int toAlpha[] = {0, 3};
             const cv::Mat opaque(color.size(), CV_8UC1, cv::Scalar(255));
             cv::mixChannels(&opaque, 1, &out, 1, toAlpha, 1);
@@ -989,7 +999,7 @@ cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encodi
     else if (owned)
         return color;
     else
-        gl::copyFrameBytes(out.data, color.data, color.total() * color.elemSize());
+        copyImage(color, out);
     return out;
 }
 
