@@ -6,10 +6,12 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
 #include <utility>
 #include <vector>
 
 #include <fmt/format.h>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace defocus {
@@ -233,6 +235,108 @@ std::string depthFitProblem(const cv::Size& colorSize, const std::string& colorN
         depthName, depthSize.width, depthSize.height, colorName, colorSize.width, colorSize.height,
         static_cast<double>(depthSize.width) / depthSize.height,
         static_cast<double>(colorSize.width) / colorSize.height);
+}
+
+namespace {
+
+/// One row's valid range and holes, added to `low`, `high` and `invalid` (in the row's units).
+void validRange(const float* z, int cols, float& low, float& high, std::size_t& invalid)
+{
+    int x = 0;
+#if CV_SIMD
+    const int lanes = cv::v_float32::nlanes;
+    if (cols >= lanes) {
+        const cv::v_float32 least = cv::vx_setall_f32(kMinValidDepthM);
+        const cv::v_float32 infinite = cv::vx_setall_f32(std::numeric_limits<float>::infinity());
+        const cv::v_float32 none = cv::vx_setall_f32(std::numeric_limits<float>::max());
+        const cv::v_float32 noneHigh = cv::vx_setall_f32(std::numeric_limits<float>::lowest());
+        cv::v_float32 lows = none, highs = noneHigh;
+        cv::v_int32 valids = cv::vx_setzero_s32(); // -1 per valid depth: a true mask is all ones
+        for (; x <= cols - lanes; x += lanes) {
+            const cv::v_float32 v = cv::vx_load(z + x);
+            const cv::v_float32 valid = (v > least) & (v < infinite); // NaN compares false
+            lows = cv::v_min(lows, cv::v_select(valid, v, none));
+            highs = cv::v_max(highs, cv::v_select(valid, v, noneHigh));
+            valids += cv::v_reinterpret_as_s32(valid);
+        }
+        low = std::min(low, cv::v_reduce_min(lows));
+        high = std::max(high, cv::v_reduce_max(highs));
+        invalid += static_cast<std::size_t>(x + cv::v_reduce_sum(valids));
+    }
+#endif
+    for (; x < cols; ++x)
+        if (isValidDepth(z[x])) {
+            low = std::min(low, z[x]);
+            high = std::max(high, z[x]);
+        } else {
+            ++invalid;
+        }
+}
+
+void validRange(const std::uint16_t* z, int cols, float& low, float& high, std::size_t& invalid)
+{
+    int x = 0;
+#if CV_SIMD
+    const int lanes = cv::v_uint16::nlanes;
+    if (cols >= lanes) {
+        // The minimum of z - 1, wrapping: a hole (0) becomes 65535 and lowers no minimum.
+        const cv::v_uint16 one = cv::vx_setall_u16(1), zero = cv::vx_setzero_u16();
+        cv::v_uint16 lows = cv::vx_setall_u16(0xFFFF), highs = zero;
+        cv::v_uint32 holes = cv::vx_setzero_u32();
+        for (; x <= cols - lanes; x += lanes) {
+            const cv::v_uint16 v = cv::vx_load(z + x);
+            lows = cv::v_min(lows, cv::v_sub_wrap(v, one));
+            highs = cv::v_max(highs, v);
+            cv::v_uint32 a, b;
+            cv::v_expand((v == zero) & one, a, b);
+            holes += a + b;
+        }
+        const unsigned lowest = cv::v_reduce_min(lows);
+        const unsigned highest = cv::v_reduce_max(highs);
+        if (lowest != 0xFFFF) { // a valid depth among the lanes
+            low = std::min(low, static_cast<float>(lowest + 1));
+            high = std::max(high, static_cast<float>(highest));
+        }
+        invalid += cv::v_reduce_sum(holes);
+    }
+#endif
+    for (; x < cols; ++x)
+        if (z[x] > 0) {
+            low = std::min(low, static_cast<float>(z[x]));
+            high = std::max(high, static_cast<float>(z[x]));
+        } else {
+            ++invalid;
+        }
+}
+
+} // namespace
+
+double validDepthRange(const cv::Mat& depth, double unitsPerMetre, float& lo, float& hi)
+{
+    CV_Assert(depth.empty() || depth.type() == CV_32FC1 || depth.type() == CV_16UC1);
+    // Rows in bands on OpenCV's threads; a minimum, a maximum and a count combine in any order.
+    float low = std::numeric_limits<float>::max(), high = std::numeric_limits<float>::lowest();
+    std::size_t invalid = 0;
+    std::mutex combine;
+    cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& range) {
+        float bandLow = std::numeric_limits<float>::max(), bandHigh = std::numeric_limits<float>::lowest();
+        std::size_t bandInvalid = 0;
+        for (int y = range.start; y < range.end; ++y) {
+            if (depth.type() == CV_32FC1)
+                validRange(depth.ptr<float>(y), depth.cols, bandLow, bandHigh, bandInvalid);
+            else
+                validRange(depth.ptr<std::uint16_t>(y), depth.cols, bandLow, bandHigh, bandInvalid);
+        }
+        const std::lock_guard lock(combine);
+        low = std::min(low, bandLow);
+        high = std::max(high, bandHigh);
+        invalid += bandInvalid;
+    });
+    if (low <= high) {
+        lo = static_cast<float>(low / unitsPerMetre);
+        hi = static_cast<float>(high / unitsPerMetre);
+    }
+    return depth.empty() ? 1.0 : static_cast<double>(invalid) / static_cast<double>(depth.total());
 }
 
 } // namespace defocus

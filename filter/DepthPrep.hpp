@@ -19,6 +19,12 @@ inline bool isValidDepth(float z)
     return z > kMinValidDepthM && z < std::numeric_limits<float>::infinity();
 }
 
+/// The range of valid depths in `depth` (any size: CV_32FC1 metres, or CV_16UC1 in
+/// `unitsPerMetre` units, 0 where nothing was measured), in metres; `lo`/`hi` unchanged when there
+/// is none. Returns the share of `depth` that is no measurement (1 when it is empty). Rows in bands
+/// on OpenCV's threads, each row in SIMD lanes: it runs on the calling thread on every frame.
+double validDepthRange(const cv::Mat& depth, double unitsPerMetre, float& lo, float& hi);
+
 struct PreparedDepth {
     cv::Mat metres;                ///< CV_32FC1, colour-sized, every pixel valid
     double invalidFraction = 0.0;  ///< share of pixels that had no measurement, [0, 1]

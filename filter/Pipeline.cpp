@@ -137,47 +137,6 @@ bool ensureTexture(gl::Texture& texture, GLenum format, cv::Size size, const cha
     return true;
 }
 
-/// The range of valid depths in `depth` (any size: float metres, or 16-bit in `unitsPerMetre`,
-/// 0 where nothing was measured), in metres; `lo`/`hi` unchanged when there is none. Returns the
-/// share of `depth` that is no measurement (1 when it is empty).
-template <typename T>
-double validDepthRange(const cv::Mat& depth, double unitsPerMetre, float& lo, float& hi)
-{
-    const auto valid = [](T z) {
-        if constexpr (std::is_same_v<T, float>)
-            return isValidDepth(z);
-        else
-            return z > 0;
-    };
-    // Rows in bands on OpenCV's threads; a minimum, a maximum and a count combine in any order.
-    float low = std::numeric_limits<float>::max(), high = std::numeric_limits<float>::lowest();
-    std::size_t invalid = 0;
-    std::mutex combine;
-    cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& range) {
-        float bandLow = std::numeric_limits<float>::max(), bandHigh = std::numeric_limits<float>::lowest();
-        std::size_t bandInvalid = 0;
-        for (int y = range.start; y < range.end; ++y) {
-            const T* z = depth.ptr<T>(y);
-            for (int x = 0; x < depth.cols; ++x)
-                if (valid(z[x])) {
-                    bandLow = std::min(bandLow, static_cast<float>(z[x]));
-                    bandHigh = std::max(bandHigh, static_cast<float>(z[x]));
-                } else {
-                    ++bandInvalid;
-                }
-        }
-        const std::lock_guard lock(combine);
-        low = std::min(low, bandLow);
-        high = std::max(high, bandHigh);
-        invalid += bandInvalid;
-    });
-    if (low <= high) {
-        lo = static_cast<float>(low / unitsPerMetre);
-        hi = static_cast<float>(high / unitsPerMetre);
-    }
-    return depth.empty() ? 1.0 : static_cast<double>(invalid) / static_cast<double>(depth.total());
-}
-
 /// GL_RENDERER of the current context, for the choices made from it (filter/gl/Renderer.hpp).
 std::string_view rendererName()
 {
@@ -542,8 +501,7 @@ void Pipeline::Impl::begin(FrameContext& f, const Frame& frame, const LensSettin
     if (quality.adaptive) {
         const auto start = Clock::now();
         float lo = f.fallbackDepth, hi = f.fallbackDepth;
-        f.invalidFraction = f.depthUnits > 0.0 ? validDepthRange<std::uint16_t>(frame.depth, f.depthUnits, lo, hi)
-                                               : validDepthRange<float>(frame.depth, 1.0, lo, hi);
+        f.invalidFraction = validDepthRange(frame.depth, f.depthUnits > 0.0 ? f.depthUnits : 1.0, lo, hi);
         const float c0 = cocPixels(lensCoc, lo), c1 = cocPixels(lensCoc, hi);
         f.timings.analysisMs = msSince(start);
         if (std::max(std::abs(c0), std::abs(c1)) < 0.5f) {

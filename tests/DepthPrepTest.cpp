@@ -228,5 +228,68 @@ TEST(DepthPrep, ASliverOfALightBesideANearBarTakesTheLightsDepth)
         << "\none pixel " << metres(cv::Rect(19, 35, 5, 3));
 }
 
+// The all-in-focus check's valid range, against a plain loop over the pixels. Defects caught: a
+// hole (0, NaN, +-Inf, negative, below kMinValidDepthM) taken as a depth or a depth as a hole, a
+// lane or row end left out (widths that are not a multiple of the SIMD lanes, a row shorter
+// than them), a 16-bit depth of 65535 or 1 lost, a view's padding read, a frame of holes given
+// a range.
+TEST(ValidDepthRange, IsWhatALoopOverThePixelsFinds)
+{
+    cv::RNG rng(7);
+    for (const cv::Size size : {cv::Size(1, 1), cv::Size(7, 3), cv::Size(16, 2), cv::Size(641, 37), cv::Size(1920, 9)})
+        for (const int type : {CV_32FC1, CV_16UC1})
+            for (const double holeShare : {0.0, 0.3, 1.0}) {
+                SCOPED_TRACE(testing::Message() << size << (type == CV_32FC1 ? " float" : " 16-bit") << ", holes "
+                                                << holeShare);
+                // A view inside a larger image: rows with padding after them.
+                cv::Mat whole(size.height + 2, size.width + 5, type);
+                cv::Mat depth = whole(cv::Rect(2, 1, size.width, size.height));
+                const float strange[] = {0.0f, -1.0f, std::numeric_limits<float>::quiet_NaN(),
+                                         std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                                         kMinValidDepthM, 0.5f * kMinValidDepthM};
+                whole.setTo(type == CV_32FC1 ? cv::Scalar(0.01) : cv::Scalar(1)); // padding: nearer than all
+                for (int y = 0; y < depth.rows; ++y)
+                    for (int x = 0; x < depth.cols; ++x) {
+                        const bool hole = rng.uniform(0.0, 1.0) < holeShare;
+                        if (type == CV_32FC1)
+                            depth.at<float>(y, x) = hole ? strange[rng.uniform(0, 7)] : rng.uniform(0.2f, 9.0f);
+                        else
+                            depth.at<std::uint16_t>(y, x) =
+                                hole ? 0 : static_cast<std::uint16_t>(rng.uniform(2, 65535 + 1));
+                    }
+                if (type == CV_16UC1 && holeShare < 1.0 && depth.total() > 2) {
+                    depth.at<std::uint16_t>(0, depth.cols - 1) = 65535;
+                    depth.at<std::uint16_t>(depth.rows - 1, depth.cols / 2) = 1;
+                }
+                float expectLo = -7.0f, expectHi = -7.0f; // "unchanged"
+                float low = std::numeric_limits<float>::max(), high = std::numeric_limits<float>::lowest();
+                std::size_t invalid = 0;
+                for (int y = 0; y < depth.rows; ++y)
+                    for (int x = 0; x < depth.cols; ++x) {
+                        const float z = type == CV_32FC1 ? depth.at<float>(y, x) : depth.at<std::uint16_t>(y, x);
+                        const bool valid = type == CV_32FC1 ? isValidDepth(z) : z > 0.0f;
+                        if (valid) {
+                            low = std::min(low, z);
+                            high = std::max(high, z);
+                        } else {
+                            ++invalid;
+                        }
+                    }
+                const double units = type == CV_32FC1 ? 1.0 : 5000.0;
+                if (low <= high) {
+                    expectLo = static_cast<float>(low / units);
+                    expectHi = static_cast<float>(high / units);
+                }
+                float lo = -7.0f, hi = -7.0f;
+                const double share = validDepthRange(depth, units, lo, hi);
+                EXPECT_EQ(lo, expectLo);
+                EXPECT_EQ(hi, expectHi);
+                EXPECT_DOUBLE_EQ(share, static_cast<double>(invalid) / static_cast<double>(depth.total()));
+            }
+    float lo = -7.0f, hi = -7.0f;
+    EXPECT_EQ(validDepthRange(cv::Mat(), 1.0, lo, hi), 1.0) << "no depth: all of it is no measurement";
+    EXPECT_EQ(lo, -7.0f);
+}
+
 } // namespace
 } // namespace defocus
