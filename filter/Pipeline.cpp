@@ -9,9 +9,7 @@
 #include <deque>
 #include <initializer_list>
 #include <map>
-#include <mutex>
 #include <string_view>
-#include <type_traits>
 #include <utility>
 
 #include <epoxy/gl.h>
@@ -922,9 +920,8 @@ void copyImage(const cv::Mat& from, cv::Mat& to)
 
 /// A frame all in focus as `encoding` asks: 8-bit input bit-exact (BGRx's fourth byte made 255),
 /// float input from `linear`, its cleaned-up copy. 8-bit input as 8-bit output goes into `out`
-/// (of the colour's size and imageType(encoding); empty otherwise); `owned`: `color` is the
-/// pipeline's own (the conversion of Y'CbCr), returned as it is where it needs no change.
-cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encoding, bool owned, cv::Mat out)
+/// (of the colour's size and imageType(encoding); empty otherwise).
+cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encoding, cv::Mat out)
 {
     if (color.depth() != CV_8U) {
         if (encoding == Encoding::Linear32F)
@@ -954,8 +951,6 @@ cv::Mat passThrough(const cv::Mat& color, const cv::Mat& linear, Encoding encodi
     }
     if (color.channels() == 4)
         cv::cvtColor(color, out, cv::COLOR_BGRA2BGR);
-    else if (owned)
-        return color;
     else
         copyImage(color, out);
     return out;
@@ -1007,15 +1002,18 @@ PendingRead Pipeline::readAsync(View view, Encoding encoding)
         // All in focus: the input is the output, bit-exact for 8-bit input; float input gets the
         // CoC pass's clean-up (no NaN, no negatives, within the target's range).
         // Y'CbCr: the bytes the GPU would have made of it.
-        const bool owned = p.current.color.empty();
-        const cv::Mat color = owned ? convertYuv(p.current.yuv) : p.current.color;
+        const bool converted = p.current.color.empty();
+        const cv::Mat color = converted ? convertYuv(p.current.yuv) : p.current.color;
         const bool srgbInput = color.depth() == CV_8U;
         const bool half = p.current.quality.targetFormat == TargetFormat::Rgba16F;
         const cv::Mat linear = srgbInput ? cv::Mat() : sanitizeLinear(color, CocParams::largestColor(half));
-        // Into an image of the pool, as a read from the GPU goes.
-        const bool pooled = srgbInput && encoding != Encoding::Linear32F && !owned;
-        read.ready = passThrough(color, linear, encoding, owned,
-                                 pooled ? p.takeOutput(p.size, imageType(encoding)) : cv::Mat());
+        if (converted && encoding == Encoding::Srgb8) // the conversion is the pipeline's own
+            read.ready = color;
+        else // into an image of the pool, as a read from the GPU goes
+            read.ready = passThrough(color, linear, encoding,
+                                     srgbInput && encoding != Encoding::Linear32F
+                                         ? p.takeOutput(p.size, imageType(encoding))
+                                         : cv::Mat());
         p.current.timings.readbackMs = msSince(start);
         p.current.timings.totalMs = p.current.spentMs();
         read.timings = p.current.timings;
