@@ -746,8 +746,9 @@ TEST(LibraryYuv, PlanesOfTheWrongShapeAreInputErrorsNamingThem)
 // Defects caught: Y'CbCr in that is not its BGR's result, on either path (the GPU's planes and
 // conversion pass under DEFOCUS_DEPTH_PREP=gpu, library_gpu_defaults; the CPU's conversion here):
 // a conversion that differs from yuvToBgr() by a level, planes with padded rows read as packed, a
-// frame all in focus that passes another colour through, frames in flight or the contact sheet
-// losing the planes. Every preset, both kernels, the plan on and off.
+// frame all in focus that passes another colour through or, for BGRA or linear output, the planes'
+// conversion unchanged; frames in flight or the contact sheet losing the planes. Every preset,
+// both kernels, the plan on and off.
 TEST(LibraryYuv, YuvInIsTheResultOfItsBgrOnEveryPreset)
 {
     const Pair pair = bundled(9);
@@ -792,6 +793,17 @@ TEST(LibraryYuv, YuvInIsTheResultOfItsBgrOnEveryPreset)
                     const cv::Mat out = filter->process(yuv, depth);
                     filter->contactSheet();
                     EXPECT_TRUE(identical(filter->process(yuv, depth), out)) << what << ", after a contact sheet";
+                    // The other outputs, blurred and all in focus (where the planes' conversion is
+                    // the output's source, made BGRA or linear as the BGR frame is).
+                    for (const auto output : {defocus::Settings::Output::Srgb8Bgra, defocus::Settings::Output::Linear32F}) {
+                        defocus::Settings other = settings;
+                        other.output = output;
+                        filter->setSettings(other);
+                        for (const cv::Mat& d : {depth, flat})
+                            EXPECT_TRUE(identical(filter->process(yuv, d), filter->process(converted, d)))
+                                << what << (output == defocus::Settings::Output::Linear32F ? ", linear" : ", BGRA")
+                                << (d.data == flat.data ? ", all in focus" : "");
+                    }
                 }
     }
 }
