@@ -44,6 +44,10 @@
 // and the object's antialiased edge near it, so its fade is gentler: the corpus measured 0.7
 // there free of any loss, 0.5 and less losing up to 0.36 dB where a large object's edge meets a
 // brighter background (docs/accuracy.md, "What each improvement bought").
+// In pass 1 the hidden share takes instead, where one is found, the background interpolated
+// across the object at the pixel itself (hiddenBackground()), not where a line leaves the
+// object: the lines off the vertical run 30 deg below the horizontal, and meet the background
+// beside a vertical object lower than the pixel by up to tan(30 deg) of the object's width.
 //
 // FIRST_PASS and NEAR_FIELD are compile-time
 // variants: llvmpipe pays for every instruction of a branch on a uniform. FUSED (second pass
@@ -100,9 +104,77 @@ vec2 pixelUv()
     return gl_FragCoord.xy / vec2(textureSize(uLine1, 0));
 }
 
+#ifdef FIRST_PASS
+// What lies behind this pixel where it is part of a blurred object: the background seen beside
+// the object, interpolated across it along the shortest crossing. The background is what is
+// farther and at most half as blurred (BEHIND_SHARPER); each of four crossings (the row, the
+// column and both diagonals) looks for it up to CROSSING_TAPS texels to either side. A crossing
+// that finds it on both sides interpolates linearly between them at this pixel; one that finds
+// it on one side only takes that side's colour and counts three times as long (the other side
+// may lie just beyond the search). The crossings found are mixed by their length^-4, so that
+// the shortest rules without a switch between neighbouring pixels (the shortest alone left
+// speckles along a sphere's silhouette on the Blender scene). On each side the pixel after the
+// first found is taken where it is background too: the first is often the object's antialiased
+// edge, whose colour holds some of the object and whose depth (not antialiased) the
+// background's. a = 0: none found within reach, and the lines' own estimate stays.
+const int CROSSING_TAPS = 8;
+const float BEHIND_SHARPER = 2.0;
+
+bool behindCenter(vec4 tap, vec4 center)
+{
+    return tap.a > center.a && abs(tap.a) * BEHIND_SHARPER < abs(center.a);
+}
+
+// One side of a crossing, step k: the step the background was found at (0: not yet), its colour.
+void crossingSide(ivec2 texel, ivec2 offset, int k, vec4 center, inout float found, inout vec3 color)
+{
+    const ivec2 last = textureSize(uLine1, 0) - 1;
+    const ivec2 at = texel + offset * k;
+    if (found > 0.0 || any(lessThan(at, ivec2(0))) || any(greaterThan(at, last)))
+        return;
+    const vec4 tap = texelFetch(uLine1, at, 0);
+    if (!behindCenter(tap, center))
+        return;
+    found = float(k);
+    color = tap.rgb;
+    const vec4 next = texelFetch(uLine1, clamp(at + offset, ivec2(0), last), 0);
+    if (behindCenter(next, center))
+        color = next.rgb;
+}
+
+vec4 hiddenBackground(vec4 center)
+{
+    const ivec2 texel = ivec2(gl_FragCoord.xy);
+    const ivec2 offsets[4] = ivec2[4](ivec2(1, 0), ivec2(0, 1), ivec2(1, 1), ivec2(1, -1));
+    const float texelLengths[4] = float[4](1.0, 1.0, 1.41421356, 1.41421356);
+    vec3 sum = vec3(0.0);
+    float weights = 0.0;
+    for (int d = 0; d < 4; ++d) {
+        float after = 0.0, before = 0.0;
+        vec3 afterColor = vec3(0.0), beforeColor = vec3(0.0);
+        for (int k = 1; k <= CROSSING_TAPS; ++k) {
+            if (after > 0.0 && before > 0.0)
+                break;
+            crossingSide(texel, offsets[d], k, center, after, afterColor);
+            crossingSide(texel, -offsets[d], k, center, before, beforeColor);
+        }
+        if (after == 0.0 && before == 0.0)
+            continue;
+        const bool both = after > 0.0 && before > 0.0;
+        const vec3 color = both ? (afterColor * before + beforeColor * after) / (after + before)
+                                : (after > 0.0 ? afterColor : beforeColor);
+        const float span = (both ? after + before : 3.0 * max(after, before)) * texelLengths[d];
+        const float weight = 1.0 / (span * span * span * span);
+        sum += color * weight;
+        weights += weight;
+    }
+    return weights > 0.0 ? vec4(sum / weights, 1.0) : vec4(0.0);
+}
+#endif
+
 void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D source2, sampler2D smoothSource2,
            const int mode2, const bool both, vec2 direction, float baseStep, vec2 across, vec4 center, vec3 center2,
-           float extent, out vec3 result, out vec3 result2)
+           float extent, out vec3 result, out vec3 result2, out vec3 hiddenMean, out float hiddenShare)
 {
     const vec2 uv = pixelUv();
     const float radius = 0.5 * abs(center.a);
@@ -186,9 +258,10 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
         background2 += tap2 * weight;
         backgroundWeight += weight;
     }
+    hiddenMean = behindNorm > 0.0 ? behind / behindNorm : vec3(0.0);
     if (behindNorm > 0.0) {
         // The mean first: a flat colour stays exactly itself.
-        background += (behind / behindNorm) * behindWeight;
+        background += hiddenMean * behindWeight;
         background2 += (behind2 / behindNorm) * behindWeight;
         backgroundWeight += behindWeight;
     }
@@ -197,10 +270,14 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
     const bool kept = backgroundWeight > 0.0;
     background = kept ? background / backgroundWeight : center.rgb;
     background2 = kept ? background2 / backgroundWeight : center2;
+    // How much of the result the hidden share's colour makes: another colour c for it moves the
+    // result by hiddenShare * (c - hiddenMean).
+    hiddenShare = kept && behindNorm > 0.0 ? behindWeight / backgroundWeight : 0.0;
 #ifdef NEAR_FIELD
     const float alpha = clamp(coverage, 0.0, 1.0);
     result = alpha * (foreground / max(coverage, 1e-6)) + (1.0 - alpha) * background;
     result2 = alpha * (foreground2 / max(coverage, 1e-6)) + (1.0 - alpha) * background2;
+    hiddenShare *= 1.0 - alpha;
 #else
     result = background;
     result2 = background2;
@@ -208,11 +285,11 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
 }
 
 vec3 line(sampler2D source, sampler2D smoothSource, const int mode, vec2 direction, float baseStep, vec2 across,
-          vec4 center, float extent)
+          vec4 center, float extent, out vec3 hiddenMean, out float hiddenShare)
 {
     vec3 result, unused;
     lines(source, smoothSource, mode, source, smoothSource, mode, false, direction, baseStep, across, center, vec3(0.0),
-          extent, result, unused);
+          extent, result, unused, hiddenMean, hiddenShare);
     return result;
 }
 
@@ -239,16 +316,34 @@ void main()
 #endif
         return;
     }
+    vec3 hiddenX, hiddenZ;
+    float shareX, shareZ;
 #ifdef FIRST_PASS
-    const vec3 x = line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent);
+    vec3 x = line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent, hiddenX,
+                  shareX);
+    vec3 z = line(uLine2, uLine2Smooth, LINE2_MODE, directions.zw, baseSteps.y, across.zw, center, extent, hiddenZ,
+                  shareZ);
+    // Only pixels whose lines have a hidden share look for the background behind them (most have
+    // none: a GPU skips the search where no pixel of a group needs it).
+    if (shareX > 0.0 || shareZ > 0.0) {
+        const vec4 behind = hiddenBackground(center);
+        if (behind.a > 0.0) {
+            x += shareX * (behind.rgb - hiddenX);
+            z += shareZ * (behind.rgb - hiddenZ);
+        }
+    }
     outFirst = vec4(x, center.a);
-    outSecond = vec4(line(uLine2, uLine2Smooth, LINE2_MODE, directions.zw, baseSteps.y, across.zw, center, extent),
-                     center.a);
+    outSecond = vec4(z, center.a);
 #else
-    const vec3 a = line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent);
+    // Pass 2's hidden share keeps its lines' own estimate. Its taps are pass-1 means, which
+    // beside a blurred object hold the object's spread; the same search over them, or over the
+    // CoC target, measured lower on the corpus (near-object 1.0-1.6 dB, railing-lights itself
+    // 0.1-0.15 dB; docs/accuracy.md).
+    const vec3 a = line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent,
+                        hiddenX, shareX);
     vec3 b1, b2;
     lines(uLine1, uLine1Smooth, LINE3_MODE, uLine2, uLine2Smooth, LINE2_MODE, true, directions.zw, baseSteps.y,
-          across.zw, center, centerB.rgb, extent, b1, b2);
+          across.zw, center, centerB.rgb, extent, b1, b2, hiddenZ, shareZ);
     const vec3 b = 0.5 * (b1 + b2);
 #ifdef FUSED
     // The composite in the same pass, straight into the output (composite.frag's SUM formula).

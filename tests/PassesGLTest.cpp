@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -206,6 +207,55 @@ TEST_F(Passes, ALineBehindABlurredBarRunsOnBehindIt)
         // past most of them. The bounds lie between.
         const bool half = preset.quality.resolution == Resolution::Half;
         EXPECT_GT(kept, half ? 0.43 : 0.6) << preset.name;
+    }
+}
+
+// What a blurred bar hides is the wall behind it at the pixel's own height. A horizontal bar far
+// in front of the focus over a wall whose brightness grows downwards: the first pass's vertical
+// line from a pixel of the bar leaves the bar at its top edge, and the share of the pixel's blur
+// that the bar hides is the wall behind the pixel, not the wall above the bar. Defect caught:
+// that share taking the colour of the wall where the line leaves the bar (a railing's bars over
+// a wall lifted the wall's lines behind them, up to tan(30 deg) of a bar's width for the lines
+// at -30 deg; docs/accuracy.md, "What each improvement bought"). Measured on the first pass's
+// output (View::Horizontal: X) at the bar's bottom rows, as the share of the difference between
+// a flat wall of the pixel's own brightness and a flat wall of the brightness above the bar by
+// which the gradient's result moves towards the latter: 0 is the wall at the pixel's height.
+TEST_F(Passes, WhatABlurredBarHidesIsTheWallAtThePixelsHeight)
+{
+    const cv::Size size(160, 120);
+    const cv::Range barRows(56, 64);
+    const float bar = 0.05f;
+    const auto wallAt = [](double y) { return 0.1 + 0.006 * y; };
+    cv::Mat depth(size, CV_32F, cv::Scalar(1.0f)); // the focus
+    depth.rowRange(barRows).setTo(0.5f);           // -30 px of CoC
+    const auto frame = [&](const std::function<double(int)>& wall) {
+        cv::Mat color(size, CV_32FC3);
+        for (int y = 0; y < size.height; ++y)
+            color.row(y).setTo(cv::Scalar::all(wall(y)));
+        color.rowRange(barRows).setTo(cv::Scalar::all(bar));
+        return color;
+    };
+    const int row = barRows.end - 2; // full-size pixels: 6 below the bar's top edge
+    const cv::Mat gradient = frame([&](int y) { return wallAt(y); });
+    const cv::Mat own = frame([&](int) { return wallAt(row); });
+    const cv::Mat above = frame([&](int) { return wallAt(barRows.start - 2); });
+    for (const test::NamedQuality& preset : test::presetsAndKernels()) {
+        if (preset.quality.kernel != HexagonKernel::RhombiSum)
+            continue;
+        const auto firstLine = [&](const cv::Mat& color) {
+            Pipeline pipeline;
+            pipeline.run({color, depth, 0.0, 0, "bar over a gradient"}, test::lensWithFarCoc(30.0), preset.quality,
+                         View::Composite, Encoding::Linear32F);
+            const cv::Mat x = pipeline.readTarget(View::Horizontal);
+            const int y = row * x.rows / size.height;
+            return static_cast<double>(x.at<cv::Vec4f>(y, x.cols / 2)[1]);
+        };
+        const double atOwn = firstLine(own), atAbove = firstLine(above), atGradient = firstLine(gradient);
+        ASSERT_GT(std::abs(atAbove - atOwn), 1e-3) << preset.name << ": the bar's blur hides none of the wall";
+        const double towardsAbove = (atGradient - atOwn) / (atAbove - atOwn);
+        std::printf("[ FIGURE   ] %s: the wall behind the bar %.2f of the way to the wall above it\n",
+                    preset.name.c_str(), towardsAbove);
+        EXPECT_LT(std::abs(towardsAbove), 0.5) << preset.name;
     }
 }
 
