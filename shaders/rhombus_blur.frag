@@ -44,10 +44,11 @@
 // and the object's antialiased edge near it, so its fade is gentler: the corpus measured 0.7
 // there free of any loss, 0.5 and less losing up to 0.36 dB where a large object's edge meets a
 // brighter background (docs/accuracy.md, "What each improvement bought").
-// In pass 1 the hidden share takes instead, where one is found, the background interpolated
-// across the object at the pixel itself (hiddenBackground()), not where a line leaves the
-// object: the lines off the vertical run 30 deg below the horizontal, and meet the background
-// beside a vertical object lower than the pixel by up to tan(30 deg) of the object's width.
+// In pass 1 the hidden share takes instead, where the lines saw the background, the background
+// interpolated across the object at the pixel itself (hiddenBackground()), not where a line
+// leaves the object: the lines off the vertical run 30 deg below the horizontal and meet the
+// background beside a vertical object lower than the pixel by up to tan(30 deg) of its width,
+// and a line leaving a horizontal object upwards sees only what lies above it.
 //
 // FIRST_PASS and NEAR_FIELD are compile-time
 // variants: llvmpipe pays for every instruction of a branch on a uniform. FUSED (second pass
@@ -104,66 +105,76 @@ vec2 pixelUv()
     return gl_FragCoord.xy / vec2(textureSize(uLine1, 0));
 }
 
-#ifdef FIRST_PASS
-// What lies behind this pixel where it is part of a blurred object: the background seen beside
-// the object, interpolated across it along the shortest crossing. The background is what is
-// farther and at most half as blurred (BEHIND_SHARPER); each of four crossings (the row, the
-// column and both diagonals) looks for it up to CROSSING_TAPS texels to either side. A crossing
-// that finds it on both sides interpolates linearly between them at this pixel; one that finds
-// it on one side only takes that side's colour and counts three times as long (the other side
-// may lie just beyond the search). The crossings found are mixed by their length^-4, so that
-// the shortest rules without a switch between neighbouring pixels (the shortest alone left
-// speckles along a sphere's silhouette on the Blender scene). On each side the pixel after the
-// first found is taken where it is background too: the first is often the object's antialiased
-// edge, whose colour holds some of the object and whose depth (not antialiased) the
-// background's. a = 0: none found within reach, and the lines' own estimate stays.
-const int CROSSING_TAPS = 8;
+// The background behind a pixel: farther, and at most half as blurred.
 const float BEHIND_SHARPER = 2.0;
-
 bool behindCenter(vec4 tap, vec4 center)
 {
     return tap.a > center.a && abs(tap.a) * BEHIND_SHARPER < abs(center.a);
 }
 
-// One side of a crossing, step k: the step the background was found at (0: not yet), its colour.
-void crossingSide(ivec2 texel, ivec2 offset, int k, vec4 center, inout float found, inout vec3 color)
+#ifdef FIRST_PASS
+// What lies behind this pixel where it is part of a blurred object: the background seen beside
+// the object, interpolated across it at the pixel. Its row and its column each look for the
+// background (behindCenter()) to either side, as far as the pixel's own blur reaches and at most
+// CROSSING_TAPS texels. One that finds it on both sides interpolates linearly between them at
+// this pixel; one that finds it on one side only takes that side's colour and counts three times
+// as long (the other side may lie just beyond the search). The two are mixed by their length^-4,
+// so that the shorter crossing rules without a switch between neighbouring pixels (the shorter
+// alone left speckles along a sphere's silhouette on the Blender scene). On each side the pixel
+// after the first found is taken where it is background too: the first is often the object's
+// antialiased edge, whose colour holds some of the object and whose depth (not antialiased) the
+// background's. The diagonals as two more crossings measured the same on the corpus, at twice
+// the search's cost. a = 0: none found, and the lines' own estimate stays.
+const int CROSSING_TAPS = 8;
+
+// One side of a crossing: the step the background was first found at (0: not yet), its colour,
+// and whether the next step may still replace it (the pixel after the first found).
+struct CrossingSide {
+    float found;
+    vec3 color;
+    bool pending;
+};
+
+void crossingStep(inout CrossingSide side, ivec2 at, vec4 center, int k)
 {
-    const ivec2 last = textureSize(uLine1, 0) - 1;
-    const ivec2 at = texel + offset * k;
-    if (found > 0.0 || any(lessThan(at, ivec2(0))) || any(greaterThan(at, last)))
-        return;
-    const vec4 tap = texelFetch(uLine1, at, 0);
-    if (!behindCenter(tap, center))
-        return;
-    found = float(k);
-    color = tap.rgb;
-    const vec4 next = texelFetch(uLine1, clamp(at + offset, ivec2(0), last), 0);
-    if (behindCenter(next, center))
-        color = next.rgb;
+    const vec4 tap = texelFetch(uLine1, clamp(at, ivec2(0), textureSize(uLine1, 0) - 1), 0);
+    const bool background = behindCenter(tap, center);
+    if (side.found == 0.0) {
+        if (background) {
+            side.found = float(k);
+            side.color = tap.rgb;
+            side.pending = true;
+        }
+    } else if (side.pending) {
+        if (background)
+            side.color = tap.rgb;
+        side.pending = false;
+    }
 }
 
 vec4 hiddenBackground(vec4 center)
 {
     const ivec2 texel = ivec2(gl_FragCoord.xy);
-    const ivec2 offsets[4] = ivec2[4](ivec2(1, 0), ivec2(0, 1), ivec2(1, 1), ivec2(1, -1));
-    const float texelLengths[4] = float[4](1.0, 1.0, 1.41421356, 1.41421356);
+    // One step past the pixel's own blur, for the pixel after the first found. Not a compile-time
+    // count, so that the loop is not unrolled and ends once every pixel shaded together is done.
+    const int steps = min(CROSSING_TAPS, int(ceil(0.5 * abs(center.a)))) + 1;
     vec3 sum = vec3(0.0);
     float weights = 0.0;
-    for (int d = 0; d < 4; ++d) {
-        float after = 0.0, before = 0.0;
-        vec3 afterColor = vec3(0.0), beforeColor = vec3(0.0);
-        for (int k = 1; k <= CROSSING_TAPS; ++k) {
-            if (after > 0.0 && before > 0.0)
+    for (int d = 0; d < 2; ++d) {
+        const ivec2 offset = d == 0 ? ivec2(1, 0) : ivec2(0, 1);
+        CrossingSide after = CrossingSide(0.0, vec3(0.0), false), before = after;
+        for (int k = 1; k <= steps; ++k) {
+            if (after.found > 0.0 && before.found > 0.0 && !after.pending && !before.pending)
                 break;
-            crossingSide(texel, offsets[d], k, center, after, afterColor);
-            crossingSide(texel, -offsets[d], k, center, before, beforeColor);
+            crossingStep(after, texel + offset * k, center, k);
+            crossingStep(before, texel - offset * k, center, k);
         }
-        if (after == 0.0 && before == 0.0)
+        if (after.found == 0.0 && before.found == 0.0)
             continue;
-        const bool both = after > 0.0 && before > 0.0;
-        const vec3 color = both ? (afterColor * before + beforeColor * after) / (after + before)
-                                : (after > 0.0 ? afterColor : beforeColor);
-        const float span = (both ? after + before : 3.0 * max(after, before)) * texelLengths[d];
+        const bool both = after.found > 0.0 && before.found > 0.0;
+        const vec3 color = both ? (after.color * before.found + before.color * after.found) / (after.found + before.found)
+                                : (after.found > 0.0 ? after.color : before.color);
+        const float span = both ? after.found + before.found : 3.0 * max(after.found, before.found);
         const float weight = 1.0 / (span * span * span * span);
         sum += color * weight;
         weights += weight;
@@ -196,6 +207,7 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
 #endif
     vec3 behind = vec3(0.0), behind2 = vec3(0.0); // the hidden share's colour, faded outwards
     float behindWeight = 0.0, behindNorm = 0.0, fade = 1.0;
+    bool sawBackground = false; // a hidden tap that is the background behind the centre
     // UNROLLED: MAX_TAPS is a compile-time constant, so the compiler unrolls the loop, and
     // llvmpipe then runs every tap for every pixel (masked); the plain loop runs only as many as
     // the longest line among the pixels it shades together, with a loop's overhead per tap. The
@@ -248,6 +260,7 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
 #endif
         const float hidden = nearer ? 0.0 : clamp(1.0 - tapPiece / max(ownPiece, 1e-6), 0.0, 1.0);
         const float hiddenWeight = weight * hidden;
+        sawBackground = sawBackground || (hiddenWeight > 0.0 && behindCenter(tap, center));
         weight -= hiddenWeight;
         behindWeight += hiddenWeight;
         behind += tap.rgb * (hiddenWeight * fade);
@@ -271,8 +284,10 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
     background = kept ? background / backgroundWeight : center.rgb;
     background2 = kept ? background2 / backgroundWeight : center2;
     // How much of the result the hidden share's colour makes: another colour c for it moves the
-    // result by hiddenShare * (c - hiddenMean).
-    hiddenShare = kept && behindNorm > 0.0 ? behindWeight / backgroundWeight : 0.0;
+    // result by hiddenShare * (c - hiddenMean). Only where the line saw the background behind the
+    // centre: a hidden share from a receding surface (each tap a little farther and sharper) has
+    // none to find, and a search for it would only cost.
+    hiddenShare = kept && sawBackground ? behindWeight / backgroundWeight : 0.0;
 #ifdef NEAR_FIELD
     const float alpha = clamp(coverage, 0.0, 1.0);
     result = alpha * (foreground / max(coverage, 1e-6)) + (1.0 - alpha) * background;
