@@ -137,7 +137,7 @@ int runCorpusAccuracy(const CorpusOptions& options, const std::string& commandLi
     gl::EglContext context = gl::EglContext::create();
     fmt::print("defocus-bench accuracy, {}; {} scene(s); GL renderer {}\ncommand: {}\n", utcNow(), scenes.size(),
                context.info().glRenderer, commandLine);
-    fmt::print("error: linear PSNR clipped to [0,1] against each scene's thin-lens truth; zones (bench/Metrics.hpp): "
+    fmt::print("measure: linear PSNR clipped to [0,1] against each scene's thin-lens truth; zones (bench/Metrics.hpp): "
                "lights = within 30 px of an input pixel above white, then depth edges, in focus, near, far\n");
 
     std::map<std::string, std::unique_ptr<Method>> methods;

@@ -589,7 +589,7 @@ int run(const Options& options, const std::string& commandLine)
                "max-coc {} px\n",
                sceneLabel, color.cols, color.rows, lens.focalLengthMm, lens.fNumber, lens.focusM, lens.sensorWidthMm,
                lens.fieldOfView == FieldOfView::FocalLength ? "focal length" : "image distance", lens.maxCocPx);
-    fmt::print("error: {}; PSNR of linear values clipped to [0,1] (and after sRGB "
+    fmt::print("measure: {}; PSNR of linear values clipped to [0,1] (and after sRGB "
                "encoding), SSIM on luma; regions in-focus {:.1f}%, out-of-focus {:.1f}%, depth-edge {:.1f}% "
                "(bench/Metrics.hpp)\n",
                gTruthTitle, 100 * unblurred.regionShare[0], 100 * unblurred.regionShare[1], 100 * unblurred.regionShare[2]);
