@@ -183,9 +183,26 @@ vec4 hiddenBackground(vec4 center)
 }
 #endif
 
+// A line's result with another colour c for its hidden share: front + back (visible + share (c -
+// visible)), its foreground's share, what the background's is, the mean of the taps not hidden
+// and the hidden share of the background. In that form a flat colour stays exactly itself, and
+// beside a light of 1e36 nothing cancels to below zero (result + share (c - the hidden share's
+// colour) did: HardCasesGLTest).
+struct Hidden {
+    vec3 front;
+    float back;
+    vec3 visible;
+    float share;
+};
+
+vec3 withHidden(Hidden h, vec3 c)
+{
+    return h.front + h.back * (h.visible + h.share * (c - h.visible));
+}
+
 void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D source2, sampler2D smoothSource2,
            const int mode2, const bool both, vec2 direction, float baseStep, vec2 across, vec4 center, vec3 center2,
-           float extent, out vec3 result, out vec3 result2, out vec3 hiddenMean, out float hiddenShare)
+           float extent, out vec3 result, out vec3 result2, out Hidden hiddenPart)
 {
     const vec2 uv = pixelUv();
     const float radius = 0.5 * abs(center.a);
@@ -271,10 +288,12 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
         background2 += tap2 * weight;
         backgroundWeight += weight;
     }
-    hiddenMean = behindNorm > 0.0 ? behind / behindNorm : vec3(0.0);
+    // The taps' own colours without the hidden share, and their weight.
+    const vec3 visible = background;
+    const float visibleWeight = backgroundWeight;
     if (behindNorm > 0.0) {
         // The mean first: a flat colour stays exactly itself.
-        background += hiddenMean * behindWeight;
+        background += (behind / behindNorm) * behindWeight;
         background2 += (behind2 / behindNorm) * behindWeight;
         backgroundWeight += behindWeight;
     }
@@ -283,16 +302,19 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
     const bool kept = backgroundWeight > 0.0;
     background = kept ? background / backgroundWeight : center.rgb;
     background2 = kept ? background2 / backgroundWeight : center2;
-    // How much of the result the hidden share's colour makes: another colour c for it moves the
-    // result by hiddenShare * (c - hiddenMean). Only where the line saw the background behind the
-    // centre: a hidden share from a receding surface (each tap a little farther and sharper) has
-    // none to find, and a search for it would only cost.
-    hiddenShare = kept && sawBackground ? behindWeight / backgroundWeight : 0.0;
+    // What the result is with another colour for the hidden share (Hidden). Only where the line
+    // saw the background behind the centre: a hidden share from a receding surface (each tap a
+    // little farther and sharper) has none to find, and a search for it would only cost.
+    hiddenPart.visible = visibleWeight > 0.0 ? visible / visibleWeight : center.rgb;
+    hiddenPart.share = kept && sawBackground ? behindWeight / backgroundWeight : 0.0;
+    hiddenPart.front = vec3(0.0);
+    hiddenPart.back = 1.0;
 #ifdef NEAR_FIELD
     const float alpha = clamp(coverage, 0.0, 1.0);
     result = alpha * (foreground / max(coverage, 1e-6)) + (1.0 - alpha) * background;
     result2 = alpha * (foreground2 / max(coverage, 1e-6)) + (1.0 - alpha) * background2;
-    hiddenShare *= 1.0 - alpha;
+    hiddenPart.front = alpha * (foreground / max(coverage, 1e-6));
+    hiddenPart.back = 1.0 - alpha;
 #else
     result = background;
     result2 = background2;
@@ -300,11 +322,11 @@ void lines(sampler2D source, sampler2D smoothSource, const int mode, sampler2D s
 }
 
 vec3 line(sampler2D source, sampler2D smoothSource, const int mode, vec2 direction, float baseStep, vec2 across,
-          vec4 center, float extent, out vec3 hiddenMean, out float hiddenShare)
+          vec4 center, float extent, out Hidden hiddenPart)
 {
     vec3 result, unused;
     lines(source, smoothSource, mode, source, smoothSource, mode, false, direction, baseStep, across, center, vec3(0.0),
-          extent, result, unused, hiddenMean, hiddenShare);
+          extent, result, unused, hiddenPart);
     return result;
 }
 
@@ -331,20 +353,17 @@ void main()
 #endif
         return;
     }
-    vec3 hiddenX, hiddenZ;
-    float shareX, shareZ;
+    Hidden hiddenX, hiddenZ;
 #ifdef FIRST_PASS
-    vec3 x = line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent, hiddenX,
-                  shareX);
-    vec3 z = line(uLine2, uLine2Smooth, LINE2_MODE, directions.zw, baseSteps.y, across.zw, center, extent, hiddenZ,
-                  shareZ);
+    vec3 x = line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent, hiddenX);
+    vec3 z = line(uLine2, uLine2Smooth, LINE2_MODE, directions.zw, baseSteps.y, across.zw, center, extent, hiddenZ);
     // Only pixels whose lines have a hidden share look for the background behind them (most have
     // none: a GPU skips the search where no pixel of a group needs it).
-    if (shareX > 0.0 || shareZ > 0.0) {
+    if (hiddenX.share > 0.0 || hiddenZ.share > 0.0) {
         const vec4 behind = hiddenBackground(center);
         if (behind.a > 0.0) {
-            x += shareX * (behind.rgb - hiddenX);
-            z += shareZ * (behind.rgb - hiddenZ);
+            x = hiddenX.share > 0.0 ? withHidden(hiddenX, behind.rgb) : x;
+            z = hiddenZ.share > 0.0 ? withHidden(hiddenZ, behind.rgb) : z;
         }
     }
     outFirst = vec4(x, center.a);
@@ -355,10 +374,10 @@ void main()
     // CoC target, measured lower on the corpus (near-object 1.0-1.6 dB, railing-lights itself
     // 0.1-0.15 dB; docs/accuracy.md).
     const vec3 a = line(uLine1, uLine1Smooth, LINE1_MODE, directions.xy, baseSteps.x, across.xy, center, extent,
-                        hiddenX, shareX);
+                        hiddenX);
     vec3 b1, b2;
     lines(uLine1, uLine1Smooth, LINE3_MODE, uLine2, uLine2Smooth, LINE2_MODE, true, directions.zw, baseSteps.y,
-          across.zw, center, centerB.rgb, extent, b1, b2, hiddenZ, shareZ);
+          across.zw, center, centerB.rgb, extent, b1, b2, hiddenZ);
     const vec3 b = 0.5 * (b1 + b2);
 #ifdef FUSED
     // The composite in the same pass, straight into the output (composite.frag's SUM formula).
