@@ -36,6 +36,7 @@
 #include "filter/Presets.hpp"
 #include "filter/Settings.hpp"
 #include "filter/gl/EglContext.hpp"
+#include "filter/gl/Objects.hpp"
 #include "filter/gl/Renderer.hpp"
 #include "samples/BenchMachine.hpp"
 #include "samples/CliOptions.hpp"
@@ -257,14 +258,6 @@ CocSpread cocSpread(const std::vector<Frame>& frames, const LensSettings& lens)
     return spread;
 }
 
-/// CPU time the calling thread has used, milliseconds: what a frame costs it besides waiting
-/// (the driver's own threads, llvmpipe's rasteriser among them, are not counted).
-double threadCpuMs()
-{
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
 
 Series& seriesNamed(std::vector<Series>& all, const std::string& key, const std::string& label)
 {
@@ -302,7 +295,7 @@ std::vector<SceneResult> measure(const std::vector<Variant>& variants, std::size
 
     struct Collected {
         SceneResult result;
-        std::vector<double> gpuSum, depthPrep, analysis, upload, render, readback, total, thread;
+        std::vector<double> gpuSum, depthPrep, analysis, upload, render, readback, total, thread, waiting;
         double cpuSeconds = 0.0, othersSeconds = 0.0;
     };
     std::vector<Collected> collected(variants.size());
@@ -320,9 +313,14 @@ std::vector<SceneResult> measure(const std::vector<Variant>& variants, std::size
     const CpuClock cpuStart = CpuClock::now();
     for (int i = 0; i < options.runs; ++i)
         for (std::size_t v = 0; v < variants.size(); ++v) {
-            const double threadStart = threadCpuMs();
+            // The calling thread's CPU time: what a frame costs it besides waiting (the driver's
+            // own threads, llvmpipe's rasteriser among them, are not counted), and of it what the
+            // fence waits took (a driver that spins while it waits charges them here).
+            const double threadStart = gl::threadCpuMs();
+            const double waitStart = gl::fenceWaits().cpuMs;
             runFrame(variants[v], options.warmup + i);
-            collected[v].thread.push_back(threadCpuMs() - threadStart);
+            collected[v].thread.push_back(gl::threadCpuMs() - threadStart);
+            collected[v].waiting.push_back(gl::fenceWaits().cpuMs - waitStart);
             const FrameTimings& t = variants[v].pipeline->timings();
             Collected& c = collected[v];
             c.result.quarterFrames += variants[v].pipeline->plan().blurShift == 2 ? 1 : 0;
@@ -350,6 +348,7 @@ std::vector<SceneResult> measure(const std::vector<Variant>& variants, std::size
         if (!c.gpuSum.empty())
             result.gpu.push_back({"sum", "GPU sum of passes", c.gpuSum});
         result.wall = {{"callingThreadCpu", "calling thread's CPU", c.thread},
+                       {"callingThreadWaitCpu", "of which in fence waits", c.waiting},
                        {"depthPrep", "depth prep (submit or CPU)", c.depthPrep},
                        {"analysis", "analysis + plan (wall)", c.analysis},
                        {"upload", "upload (wall)", c.upload},

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cstring>
+#include <ctime>
 #include <stdexcept>
 #include <utility>
 
@@ -15,10 +16,24 @@ namespace defocus::gl {
 
 void deleteTexture(GLuint id) { glDeleteTextures(1, &id); }
 
+namespace {
+thread_local FenceWaits gFenceWaits;
+}
+
+double threadCpuMs()
+{
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
+FenceWaits fenceWaits() { return gFenceWaits; }
+
 void waitAndDelete(GLsync& fence)
 {
     if (fence == nullptr)
         return;
+    const FenceWaitScope scope(gFenceWaits);
     // The first wait flushes; later ones wait a second at a time.
     GLbitfield flags = GL_SYNC_FLUSH_COMMANDS_BIT;
     while (glClientWaitSync(fence, flags, 1'000'000'000) == GL_TIMEOUT_EXPIRED)

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 #include <string_view>
 #include <utility>
 
@@ -61,8 +62,38 @@ void deleteQuery(GLuint id);
 void deleteProgram(GLuint id);
 
 /// Waits until the GPU has passed `fence` (flushing first, then a second at a time) and deletes
-/// it; nothing for a null fence.
+/// it; nothing for a null fence. Counted in fenceWaits().
 void waitAndDelete(GLsync& fence);
+
+/// The CPU time the calling thread has used, milliseconds.
+double threadCpuMs();
+
+/// The calling thread's waits in waitAndDelete() since it started: how many, and the CPU time
+/// they took (the flush that the first wait starts included). A driver that spins while it
+/// waits (NVIDIA's yields in a loop unless told otherwise) charges the wait to the thread's CPU
+/// time, so the bench reports it apart from the frame's own work.
+struct FenceWaits {
+    std::int64_t count = 0;
+    double cpuMs = 0.0;
+};
+FenceWaits fenceWaits();
+
+/// Adds the CPU time the calling thread spends in its scope, and one wait, to `into`.
+class FenceWaitScope {
+public:
+    explicit FenceWaitScope(FenceWaits& into) : into_(into), start_(threadCpuMs()) {}
+    ~FenceWaitScope()
+    {
+        into_.cpuMs += threadCpuMs() - start_;
+        ++into_.count;
+    }
+    FenceWaitScope(const FenceWaitScope&) = delete;
+    FenceWaitScope& operator=(const FenceWaitScope&) = delete;
+
+private:
+    FenceWaits& into_;
+    double start_;
+};
 
 /// memcpy() of a frame's bytes to or from a mapped buffer, in stripes on OpenCV's threads where
 /// it is large enough to pay for them: one core's memcpy does not reach the memory's bandwidth,
