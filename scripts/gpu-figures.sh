@@ -15,8 +15,8 @@
 #                                             build's throughput and per-stage rows, alternating,
 #                                             three rounds (versus.txt)
 # DEFOCUS_GPU_STEPS=a,b,... runs only those steps of run (info and machine.txt always): versus,
-# throughput, passes, passes-finished, prep, compute, frames, aperture-bench, apertures, read,
-# i420, yuyv, write.
+# throughput, passes, yield, passes-finished, prep, compute, frames, aperture-bench, apertures,
+# read, i420, yuyv, write.
 # On the lent machine, whose $OUT brings back only a few files, run into a temporary folder and
 # tar it into $OUT.
 # pack needs the bundler of ../shared/tools/gpu (or DEFOCUS_GPU_TOOLS=DIR): it is the project's
@@ -105,6 +105,16 @@ case ${1:-} in
     if wanted passes; then
       step passes "$unpacked/bin/defocus-bench" --sizes "$sizes" --runs "$frames" --warmup 5 --json "$out/bench.json"
     fi
+    if wanted yield; then
+      # The per-stage rows with NVIDIA's driver sleeping in its waits instead of yielding in a
+      # loop (__GL_YIELD=USLEEP), beside the default: how much of the calling thread's CPU row
+      # ("of which in fence waits") is spinning, and what sleeping costs the wall time.
+      for round in 1 2; do
+        step "yield-default-$round" "$unpacked/bin/defocus-bench" --sizes "${sizes#*,}" --runs "$frames" --warmup 5
+        step "yield-usleep-$round" env __GL_YIELD=USLEEP "$unpacked/bin/defocus-bench" --sizes "${sizes#*,}" \
+          --runs "$frames" --warmup 5
+      done
+    fi
     if wanted passes-finished; then
       # Each pass's wall time with the GPU idle before it: a timer query's scope also holds what
       # the pass waited for (the frame's transfer to the GPU, for the first passes to read it).
@@ -171,7 +181,8 @@ case ${1:-} in
       step write "$unpacked/bin/defocus-bench" write --size 1920x1080 --frames 48 --threads 1,2,4,8 --passes 3 ||
         echo "gpu-figures: writing not measured (see $out/write.txt)"
     fi
-    echo "gpu-figures: done; $out holds machine.txt, info.txt, throughput.txt, passes.txt, bench.json, passes-finished.txt, prep.txt, bench-prep.json, compute.txt, bench-compute.json, frame-*.exr, aperture-bench-*.txt, apertures-*.txt, read.txt, i420.txt, yuyv.txt, write.txt"
+    files=("$out"/*)
+    echo "gpu-figures: done; $out holds ${files[*]##*/}"
     ;;
   *)
     echo "usage: scripts/gpu-figures.sh pack [BUILD_DIR [OLD_BUILD_DIR]] | run [OUT_DIR]" >&2
