@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <initializer_list>
 #include <optional>
+#include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -72,6 +74,10 @@ std::string printable(Bytes type)
     for (const unsigned char c : type)
         out += c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?';
     return out;
+}
+std::string printable(std::string_view text)
+{
+    return printable(Bytes(reinterpret_cast<const unsigned char*>(text.data()), text.size()));
 }
 
 // PNG (ISO/IEC 15948): signature, then chunks of length (4, big-endian), type (4), data, CRC (4);
@@ -279,6 +285,46 @@ ImageHeader readWebP(Bytes bytes)
     return failed(ImageFormat::WebP, fmt::format("unsupported WebP: first chunk '{}'", printable(chunk)));
 }
 
+// How many bytes OpenEXR reads for a value of `type` at `at`, where it reads a type it knows by
+// its content rather than by the size the header gives: a fixed size, a channel list up to its
+// empty name, a preview by its width and height. nullopt: a type read by its size (strings,
+// vectors, every type OpenEXR does not know). A channel list that runs off the file counts one
+// byte more than there is.
+std::optional<std::uint64_t> exrValueBytes(std::string_view type, Bytes bytes, std::size_t at)
+{
+    static constexpr std::array<std::pair<std::string_view, std::uint64_t>, 24> fixed = {{
+        {"box2i", 16}, {"box2f", 16}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12}, {"v3d", 24},
+        {"m33f", 36}, {"m33d", 72}, {"m44f", 64}, {"m44d", 128}, {"int", 4}, {"float", 4}, {"double", 8},
+        {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1}, {"rational", 8},
+        {"timecode", 8}, {"keycode", 28}, {"chromaticities", 32}, {"tiledesc", 9},
+    }};
+    for (const auto& [name, size] : fixed)
+        if (type == name)
+            return size;
+    if (type == "chlist") {
+        // Channels: a name (at most 255 bytes) NUL, 16 bytes of pixel type and sampling; an empty
+        // name ends the list.
+        std::size_t end = at;
+        while (true) {
+            const std::size_t start = end;
+            while (end < bytes.size() && bytes[end] != 0 && end - start <= 255)
+                ++end;
+            if (end >= bytes.size() || end - start > 255)
+                return bytes.size() - at + 1;
+            if (end++ == start)
+                return end - at;
+            end += 16;
+        }
+    }
+    if (type == "preview") {
+        const auto width = readLe(bytes, at, 4), height = readLe(bytes, at + 4, 4);
+        if (!width || !height)
+            return bytes.size() - at + 1;
+        return 8 + 4 * *width * *height;
+    }
+    return std::nullopt;
+}
+
 // OpenEXR: magic, a version word with flags, then attributes (name NUL, type NUL, 32-bit size,
 // value) up to an empty name. dataWindow (box2i: xMin, yMin, xMax, yMax) gives the size. A
 // single-part scan-line file follows with one 64-bit offset per chunk of scan lines, each chunk
@@ -314,6 +360,14 @@ ImageHeader readExr(Bytes bytes)
         if (!size || asSigned32(*size) < 0 || at + 4 + *size > bytes.size())
             return failed(ImageFormat::OpenExr, fmt::format("truncated OpenEXR: it ends inside attribute '{}'", name));
         at += 4;
+        // OpenEXR goes on after a value of a type it knows from where its content ends, not from
+        // where the size says: a channel list whose size disagreed with its names had it read
+        // another dataWindow further on than this walk did (a fuzzed file: 8x65542 here, 8x6
+        // decoded). Refusing such a value keeps both walks in step.
+        if (const auto content = exrValueBytes(type, bytes, at); content && *content != *size)
+            return failed(ImageFormat::OpenExr,
+                          fmt::format("corrupt OpenEXR: attribute '{}' of type '{}' holds {} bytes, its size says {}",
+                                      printable(name), printable(type), *content, *size));
         // OpenEXR keeps the last of repeated attributes; refusing repeats keeps both readers of
         // the size in agreement.
         if (name == "dataWindow" || name == "compression") {

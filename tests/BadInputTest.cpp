@@ -152,6 +152,47 @@ TEST(BadImage, TruncatedExrNamesTheMissingChunk)
     EXPECT_CONTAINS(errorOf([&] { readColor(dir / "header.exr"); }), "truncated OpenEXR");
 }
 
+// OpenEXR reads a value of a type it knows by its content, not by the size the header gives it,
+// and goes on from where the content ends. Defect caught: the header check skipping such a
+// value by its size, so that where the two disagree the check and the decoder walk on from
+// different bytes and may size the image from different dataWindows (a fuzzed file: 8x65542 by
+// the check, 8x6 decoded), which the check's pixel limit then does not hold for.
+TEST(BadImage, ExrValueOfAnotherSizeThanItsTypeIsRefusedNamingTheAttribute)
+{
+    const fs::path dir = test::scratchDir("Bad_exr_value_size");
+    writeImage(dir / "whole.exr", cv::Mat(6, 8, CV_32FC1, cv::Scalar(2.0f)));
+    const std::vector<char> bytes = bytesOf(dir / "whole.exr");
+    const std::string_view text(bytes.data(), bytes.size());
+    ASSERT_EQ(readDepth(dir / "whole.exr", 1000.0).size(), cv::Size(8, 6));
+    // The size field of an attribute: after its name, NUL, type, NUL.
+    const auto sizeField = [&](std::string_view nameAndType) {
+        const std::size_t at = text.find(nameAndType);
+        EXPECT_NE(at, std::string_view::npos) << nameAndType;
+        return at + nameAndType.size();
+    };
+    const auto withSize = [&](std::size_t field, std::uint32_t size) {
+        std::vector<char> out = bytes;
+        for (int i = 0; i < 4; ++i)
+            out[field + static_cast<std::size_t>(i)] = static_cast<char>(size >> (8 * i) & 0xff);
+        return out;
+    };
+    // A channel list one byte shorter than its names and their 16 bytes each.
+    const std::size_t channels = sizeField(std::string_view("channels\0chlist\0", 16));
+    const std::uint32_t listed = static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[channels])) |
+                                 static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[channels + 1])) << 8;
+    std::vector<char> shortList = withSize(channels, listed - 1);
+    writeBytes(dir / "chlist.exr", shortList, shortList.size());
+    const std::string chlist = errorOf([&] { readDepth(dir / "chlist.exr", 1000.0); });
+    EXPECT_CONTAINS(chlist, (dir / "chlist.exr").string());
+    EXPECT_CONTAINS(chlist, fmt::format("attribute 'channels' of type 'chlist' holds {} bytes, its size says {}",
+                                        listed, listed - 1));
+    // A box2i of 20 bytes.
+    std::vector<char> wideBox = withSize(sizeField(std::string_view("displayWindow\0box2i\0", 20)), 20);
+    writeBytes(dir / "box.exr", wideBox, wideBox.size());
+    EXPECT_CONTAINS(errorOf([&] { readColor(dir / "box.exr"); }),
+                    "attribute 'displayWindow' of type 'box2i' holds 16 bytes, its size says 20");
+}
+
 TEST(BadImage, TruncatedJpegIsAnErrorNotGreyPadding)
 {
     const fs::path dir = test::scratchDir("Bad_jpeg_truncated");
