@@ -183,11 +183,12 @@ vec4 hiddenBackground(vec4 center)
 }
 #endif
 
-// A line's result with another colour c for its hidden share: front + back (visible + share (c -
-// visible)), its foreground's share, what the background's is, the mean of the taps not hidden
-// and the hidden share of the background. In that form a flat colour stays exactly itself, and
-// beside a light of 1e36 nothing cancels to below zero (result + share (c - the hidden share's
-// colour) did: HardCasesGLTest).
+// A line's result with another colour c for its hidden share: front + back (visible + share
+// (c - visible)), with front its foreground's part (alpha times the foreground's colour), back
+// the background's share (1 - alpha), visible the mean of its taps not hidden and share the
+// hidden share of the background. In that form a flat colour stays exactly itself, and beside a
+// light of 1e36 nothing cancels to below zero (result + share (c - the hidden share's colour)
+// did: HardCasesGLTest).
 struct Hidden {
     vec3 front;
     float back;
