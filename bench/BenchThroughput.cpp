@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <optional>
 
 #include <fmt/format.h>
@@ -12,6 +11,7 @@
 
 #include "defocus/Filter.hpp"
 #include "defocus/Source.hpp"
+#include "filter/gl/Objects.hpp"
 #include "samples/BenchMachine.hpp"
 #include "samples/ExitStatus.hpp"
 #include "tests/YuvPlanes.hpp"
@@ -20,13 +20,6 @@ namespace defocus {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double threadCpuMs()
-{
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
 
 /// --versus-yuv: the table of Y'CbCr in flight against BGR in flight, per size.
 int runVersusYuv(const ThroughputOptions& options, const std::vector<Frame>& clip, Filter& filter)
@@ -52,7 +45,7 @@ int runVersusYuv(const ThroughputOptions& options, const std::vector<Frame>& cli
         const auto timed = [&](bool planes, std::vector<cv::Mat>* outputs, double& cpuMs) {
             filter.reset();
             const auto start = Clock::now();
-            const double cpu = threadCpuMs();
+            const double cpu = gl::threadCpuMs();
             const auto take = [&] {
                 cv::Mat out = *filter.receive();
                 if (outputs)
@@ -69,7 +62,7 @@ int runVersusYuv(const ThroughputOptions& options, const std::vector<Frame>& cli
             }
             while (filter.framesInFlight() > 0)
                 take();
-            cpuMs = (threadCpuMs() - cpu) / options.frames;
+            cpuMs = (gl::threadCpuMs() - cpu) / options.frames;
             return std::chrono::duration<double, std::milli>(Clock::now() - start).count() / options.frames;
         };
         filter.process(bgr[0], depth[0]); // warm: targets of this size
@@ -150,18 +143,18 @@ int runThroughput(const ThroughputOptions& options)
         for (int pass = 0; pass < options.passes; ++pass) {
             filter.reset();
             auto start = Clock::now();
-            double cpu = threadCpuMs();
+            double cpu = gl::threadCpuMs();
             for (int i = 0; i < options.frames; ++i) {
                 cv::Mat out = filter.process(at(i).first, at(i).second);
                 if (pass == 0)
                     serialOut.push_back(out);
             }
-            serialCpu.push_back((threadCpuMs() - cpu) / options.frames);
+            serialCpu.push_back((gl::threadCpuMs() - cpu) / options.frames);
             serialMs.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count() / options.frames);
 
             filter.reset();
             start = Clock::now();
-            cpu = threadCpuMs();
+            cpu = gl::threadCpuMs();
             const auto take = [&] {
                 cv::Mat out = *filter.receive();
                 if (pass == 0)
@@ -174,7 +167,7 @@ int runThroughput(const ThroughputOptions& options)
             }
             while (filter.framesInFlight() > 0)
                 take();
-            flightCpu.push_back((threadCpuMs() - cpu) / options.frames);
+            flightCpu.push_back((gl::threadCpuMs() - cpu) / options.frames);
             flightMs.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count() / options.frames);
         }
         for (std::size_t i = 0; i < serialOut.size(); ++i) {

@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -257,7 +256,6 @@ CocSpread cocSpread(const std::vector<Frame>& frames, const LensSettings& lens)
     spread.p90AbsPx = *top;
     return spread;
 }
-
 
 Series& seriesNamed(std::vector<Series>& all, const std::string& key, const std::string& label)
 {
