@@ -373,11 +373,12 @@ ImageHeader readExr(Bytes bytes)
         if (name == "dataWindow" || name == "compression") {
             if ((name == "dataWindow" && window) || (name == "compression" && compression))
                 return failed(ImageFormat::OpenExr, fmt::format("corrupt OpenEXR: attribute '{}' is repeated", name));
-            if (name == "dataWindow" && type == "box2i" && *size == 16)
+            // Their sizes are their types' (checked above).
+            if (name == "dataWindow" && type == "box2i")
                 window = std::array<std::int64_t, 4>{
                     asSigned32(*readLe(bytes, at, 4)), asSigned32(*readLe(bytes, at + 4, 4)),
                     asSigned32(*readLe(bytes, at + 8, 4)), asSigned32(*readLe(bytes, at + 12, 4))};
-            else if (name == "compression" && type == "compression" && *size == 1)
+            else if (name == "compression" && type == "compression")
                 compression = bytes[at];
             else
                 return failed(ImageFormat::OpenExr, fmt::format("corrupt OpenEXR: attribute '{}' of type '{}'", name, type));
